@@ -1,0 +1,26 @@
+-- dmech.init -- the Lua side of `require "dmech"`.
+--
+-- luaopen_dmech (C) builds the table of C functions and registers it as
+-- package.loaded["dmech.core"]; this file adds what is natural in Lua (help,
+-- apropos, configuration) and returns the finished module table.
+local dm = require "dmech.core"
+
+dm._VERSION = "dmech 0.1.0"
+dm.config = dm.config or {}
+
+local help = require "dmech.help"
+dm.help = help.help
+dm.apropos = help.apropos
+dm.doc("dm.help", "help([x | \"name\"])",
+       "Show the signature and description of a function, method, class or name; help() lists the modules.",
+       dm.help)
+dm.doc("dm.apropos", "apropos(\"word\")",
+       "List every documented name whose name or description contains the word.", dm.apropos)
+
+local print_ = require "dmech.print"
+dm.pretty = print_.pretty
+dm.doc("dm.pretty", "dm.pretty(x[, depth]) -> string",
+       "The REPL's rendering of a value: tables to depth 3 with truncation, objects by __tostring.",
+       dm.pretty)
+
+return dm

@@ -1,0 +1,427 @@
+/* main.c -- the dmech program: a lua-compatible command line around the dmech
+ * library.  Modelled on lua.c (Lua 5.4): options -e -l -i -v -E -W - --,
+ * LUA_INIT / DMECH_INIT, the `arg` table, tracebacks on errors, exit status 1
+ * on failure.  `dm` (and `help`, `apropos`) are globals; `require "dmech"`
+ * returns the same table.
+ */
+#include <config.h>
+
+#include <locale.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <lauxlib.h>
+#include <lua.h>
+#include <lualib.h>
+
+#include "core/interrupt.h"
+#include "lua/dmlua.h"
+#include "repl.h"
+
+static const char *progname = DM_PROGNAME;
+
+/* {======================================================================
+ * Ctrl-C: first press stops the running code, a second one quits
+ * ======================================================================= */
+
+static lua_State *globalL = NULL;
+static volatile sig_atomic_t sigint_count = 0;
+
+/* Hook set by the signal handler: fires at the next Lua instruction.  If a C
+ * loop already consumed the interrupt (it returned its partial result and
+ * cleared the flag) there is nothing left to stop. */
+static void lstop(lua_State *L, lua_Debug *ar)
+{
+  (void)ar;
+  lua_sethook(L, NULL, 0, 0);
+  if (dm_interrupted()) {
+    dm_interrupt_clear();
+    luaL_error(L, "interrupted!");
+  }
+}
+
+static void laction(int sig)
+{
+  int flag = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
+  if (++sigint_count > 1) {          /* second Ctrl-C in the same run: quit */
+    signal(sig, SIG_DFL);
+    raise(sig);
+    return;
+  }
+  dm_interrupt_raise();
+  lua_sethook(globalL, lstop, flag, 1);
+}
+
+static int msghandler(lua_State *L)
+{
+  const char *msg = lua_tostring(L, 1);
+  if (msg == NULL) {
+    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING)
+      return 1;
+    msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+  }
+  luaL_traceback(L, L, msg, 1);
+  return 1;
+}
+
+int dm_docall(lua_State *L, int narg, int nres)
+{
+  int status, base = lua_gettop(L) - narg;
+  struct sigaction sa, old;
+  lua_pushcfunction(L, msghandler);
+  lua_insert(L, base);
+  globalL = L;
+  sigint_count = 0;
+  dm_interrupt_clear();
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = laction;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old);
+  status = lua_pcall(L, narg, nres, base);
+  sigaction(SIGINT, &old, NULL);
+  lua_sethook(L, NULL, 0, 0);
+  dm_interrupt_clear();
+  lua_remove(L, base);
+  return status;
+}
+
+static void l_message(const char *pname, const char *msg)
+{
+  if (pname)
+    fprintf(stderr, "%s: ", pname);
+  fprintf(stderr, "%s\n", msg);
+  fflush(stderr);
+}
+
+int dm_report(lua_State *L, int status)
+{
+  if (status != LUA_OK) {
+    const char *msg = lua_tostring(L, -1);
+    l_message(progname, msg != NULL ? msg : "(error object is not a string)");
+    lua_pop(L, 1);
+  }
+  return status;
+}
+
+/* }====================================================================== */
+
+static void print_usage(const char *badoption)
+{
+  FILE *f = badoption != NULL ? stderr : stdout;
+  if (badoption != NULL) {
+    if (badoption[1] == 'e' || badoption[1] == 'l')
+      fprintf(f, "%s: '%s' needs argument\n", progname, badoption);
+    else
+      fprintf(f, "%s: unrecognized option '%s'\n", progname, badoption);
+  }
+  fprintf(f,
+    "usage: %s [options] [script [args]]\n"
+    "Computational geometric mechanics at a Lua 5.4 prompt.\n"
+    "Available options are:\n"
+    "  -e stat   execute string 'stat'\n"
+    "  -i        enter interactive mode after executing 'script'\n"
+    "  -l mod    require library 'mod' into global 'mod'\n"
+    "  -l g=mod  require library 'mod' into global 'g'\n"
+    "  -v        show version information\n"
+    "  -E        ignore environment variables (DMECH_INIT, LUA_INIT, DMECH_PATH)\n"
+    "  -W        turn warnings on\n"
+    "  --help    show this help and exit\n"
+    "  --        stop handling options\n"
+    "  -         stop handling options and execute stdin\n"
+    "Environment: DMECH_INIT (else LUA_INIT_5_4, LUA_INIT) runs first;\n"
+    "DMECH_PATH adds directories searched for dmech's Lua library;\n"
+    "DMECH_GNUPLOT names the gnuplot program.\n"
+    "In the interactive prompt: help(x), help \"name\", apropos \"word\".\n",
+    progname);
+  fflush(f);
+}
+
+static void print_version(void)
+{
+  printf("%s %s (%s, GSL)\n", PACKAGE_NAME, PACKAGE_VERSION, LUA_RELEASE);
+  fflush(stdout);
+}
+
+/* {======================================================================
+ * argument handling (as in lua.c)
+ * ======================================================================= */
+
+#define has_error 1
+#define has_i 2
+#define has_v 4
+#define has_e 8
+#define has_E 16
+#define has_help 32
+
+static int collectargs(char **argv, int *first)
+{
+  int args = 0, i;
+  if (argv[0] != NULL) {
+    if (argv[0][0])
+      progname = argv[0];
+  } else {
+    *first = -1;
+    return 0;
+  }
+  for (i = 1; argv[i] != NULL; i++) {
+    *first = i;
+    if (argv[i][0] != '-')
+      return args;
+    switch (argv[i][1]) {
+    case '-':
+      if (strcmp(argv[i], "--help") == 0)
+        return args | has_help;
+      if (argv[i][2] != '\0')
+        return has_error;
+      *first = i + 1;
+      return args;
+    case '\0':
+      return args;
+    case 'E':
+      if (argv[i][2] != '\0')
+        return has_error;
+      args |= has_E;
+      break;
+    case 'W':
+      if (argv[i][2] != '\0')
+        return has_error;
+      break;
+    case 'i':
+      args |= has_i;  /* fall through: -i implies -v */
+      /* FALLTHROUGH */
+    case 'v':
+      if (argv[i][2] != '\0')
+        return has_error;
+      args |= has_v;
+      break;
+    case 'e':
+      args |= has_e;
+      /* FALLTHROUGH */
+    case 'l':
+      if (argv[i][2] == '\0') {
+        i++;
+        if (argv[i] == NULL || argv[i][0] == '-')
+          return has_error;
+      }
+      break;
+    default:
+      return has_error;
+    }
+  }
+  *first = 0;
+  return args;
+}
+
+static void createargtable(lua_State *L, char **argv, int argc, int script)
+{
+  int i, narg;
+  if (script == argc)
+    script = 0;
+  narg = argc - (script + 1);
+  lua_createtable(L, narg, script + 1);
+  for (i = 0; i < argc; i++) {
+    lua_pushstring(L, argv[i]);
+    lua_rawseti(L, -2, i - script);
+  }
+  lua_setglobal(L, "arg");
+}
+
+static int dochunk(lua_State *L, int status)
+{
+  if (status == LUA_OK)
+    status = dm_docall(L, 0, 0);
+  return dm_report(L, status);
+}
+
+static int dostring(lua_State *L, const char *s, const char *name)
+{
+  return dochunk(L, luaL_loadbuffer(L, s, strlen(s), name));
+}
+
+static int dolibrary(lua_State *L, char *globname)
+{
+  int status;
+  char *modname = strchr(globname, '=');
+  if (modname == NULL)
+    modname = globname;
+  else {
+    *modname = '\0';
+    modname++;
+  }
+  lua_getglobal(L, "require");
+  lua_pushstring(L, modname);
+  status = dm_docall(L, 1, 1);
+  if (status == LUA_OK)
+    lua_setglobal(L, globname);
+  return dm_report(L, status);
+}
+
+static int pushargs(lua_State *L)
+{
+  int i, n;
+  if (lua_getglobal(L, "arg") != LUA_TTABLE)
+    luaL_error(L, "'arg' is not a table");
+  n = (int)luaL_len(L, -1);
+  luaL_checkstack(L, n + 3, "too many arguments to script");
+  for (i = 1; i <= n; i++)
+    lua_rawgeti(L, -i, i);
+  lua_remove(L, -i);
+  return n;
+}
+
+static int handle_script(lua_State *L, char **argv)
+{
+  int status;
+  const char *fname = argv[0];
+  if (strcmp(fname, "-") == 0 && strcmp(argv[-1], "--") != 0)
+    fname = NULL;   /* stdin */
+  status = luaL_loadfile(L, fname);
+  if (status == LUA_OK) {
+    int n = pushargs(L);
+    status = dm_docall(L, n, LUA_MULTRET);
+  }
+  return dm_report(L, status);
+}
+
+static int runargs(lua_State *L, char **argv, int n)
+{
+  int i;
+  for (i = 1; i < n; i++) {
+    int option = argv[i][1];
+    switch (option) {
+    case 'e':
+    case 'l': {
+      int status;
+      char *extra = argv[i] + 2;
+      if (*extra == '\0')
+        extra = argv[++i];
+      status = (option == 'e') ? dostring(L, extra, "=(command line)")
+                               : dolibrary(L, extra);
+      if (status != LUA_OK)
+        return 0;
+      break;
+    }
+    case 'W':
+      lua_warning(L, "@on", 0);
+      break;
+    }
+  }
+  return 1;
+}
+
+static int handle_init(lua_State *L)
+{
+  const char *name = "=DMECH_INIT";
+  const char *init = getenv("DMECH_INIT");
+  if (init == NULL || *init == '\0') {
+    name = "=LUA_INIT_5_4";
+    init = getenv("LUA_INIT_5_4");
+  }
+  if (init == NULL || *init == '\0') {
+    name = "=LUA_INIT";
+    init = getenv("LUA_INIT");
+  }
+  if (init == NULL || *init == '\0')
+    return LUA_OK;
+  if (init[0] == '@')
+    return dochunk(L, luaL_loadfile(L, init + 1));
+  return dostring(L, init, name);
+}
+
+/* }====================================================================== */
+
+/* Make `require "dmech"` find the built-in module and set the globals. */
+static int open_dmech(lua_State *L)
+{
+  int status;
+  luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_PRELOAD_TABLE);
+  lua_pushcfunction(L, luaopen_dmech);
+  lua_setfield(L, -2, "dmech");
+  lua_pop(L, 1);
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech");
+  status = dm_docall(L, 1, 1);
+  if (status != LUA_OK)
+    return dm_report(L, status);
+  lua_getfield(L, -1, "help");
+  lua_setglobal(L, "help");
+  lua_getfield(L, -1, "apropos");
+  lua_setglobal(L, "apropos");
+  lua_setglobal(L, "dm");
+  return LUA_OK;
+}
+
+static int pmain(lua_State *L)
+{
+  int argc = (int)lua_tointeger(L, 1);
+  char **argv = (char **)lua_touserdata(L, 2);
+  int script;
+  int args = collectargs(argv, &script);
+  luaL_checkversion(L);
+  if (args == has_error) {
+    print_usage(argv[script]);
+    return 0;
+  }
+  if (args & has_help) {
+    print_usage(NULL);
+    lua_pushboolean(L, 1);
+    return 1;
+  }
+  if (args & has_v)
+    print_version();
+  if (args & has_E) {
+    lua_pushboolean(L, 1);
+    lua_setfield(L, LUA_REGISTRYINDEX, "LUA_NOENV");
+    unsetenv("DMECH_PATH");
+  }
+  luaL_openlibs(L);
+  createargtable(L, argv, argc, script);
+  lua_gc(L, LUA_GCGEN, 0, 0);
+  if (open_dmech(L) != LUA_OK)
+    return 0;
+  if (!(args & has_E)) {
+    if (handle_init(L) != LUA_OK)
+      return 0;
+  }
+  if (!runargs(L, argv, script > 0 ? script : argc))
+    return 0;
+  if (script > 0) {
+    if (handle_script(L, argv + script) != LUA_OK)
+      return 0;
+  }
+  if (args & has_i) {
+    dm_repl(L);
+  } else if (script < 1 && !(args & (has_e | has_v))) {
+    if (isatty(0)) {
+      print_version();
+      dm_repl(L);
+    } else {
+      dochunk(L, luaL_loadfile(L, NULL));
+    }
+  }
+  lua_pushboolean(L, 1);
+  return 1;
+}
+
+int main(int argc, char **argv)
+{
+  int status, result;
+  lua_State *L;
+  setlocale(LC_CTYPE, "");        /* Readline and UTF-8; numbers stay "C" */
+  L = luaL_newstate();
+  if (L == NULL) {
+    l_message(argv[0], "cannot create state: not enough memory");
+    return EXIT_FAILURE;
+  }
+  lua_pushcfunction(L, pmain);
+  lua_pushinteger(L, argc);
+  lua_pushlightuserdata(L, argv);
+  status = lua_pcall(L, 2, 1, 0);
+  result = lua_toboolean(L, -1);
+  dm_report(L, status);
+  lua_close(L);
+  return (result && status == LUA_OK) ? EXIT_SUCCESS : EXIT_FAILURE;
+}

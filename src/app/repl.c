@@ -1,0 +1,401 @@
+/* repl.c -- the interactive loop (modelled on lua.c's doREPL).
+ *
+ * Adds to lua.c: results auto-print through dmech.print's pretty printer; a
+ * trailing ';' suppresses printing; `_` holds the last result; a multi-line
+ * chunk is one history entry; history persists in
+ * $XDG_STATE_HOME/dmech/history (else ~/.dmech_history), appended per entry;
+ * Ctrl-C at the prompt clears the line (Readline's callback interface, so no
+ * longjmp out of Readline); tab completion (complete.c).  Without a terminal
+ * (or without Readline) lines come from stdio and prompts from
+ * _PROMPT/_PROMPT2.
+ */
+#include <config.h>
+
+#include <errno.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <lauxlib.h>
+#include <lua.h>
+
+#ifdef HAVE_READLINE
+#include <readline/history.h>
+#include <readline/readline.h>
+#endif
+
+#include "repl.h"
+
+#define PROMPT1 "dm> "
+#define PROMPT2 ".. "
+#define MAXINPUT 512
+#define HISTORY_KEEP 10000
+
+static int use_readline = 0;
+static char *history_path = NULL;
+
+/* {======================================================================
+ * line input: Readline (callback interface) or stdio
+ * ======================================================================= */
+
+#ifdef HAVE_READLINE
+static volatile sig_atomic_t prompt_sigint = 0, prompt_sigwinch = 0;
+static char *cb_line;
+static int cb_done;
+
+static void on_sigint(int sig) { (void)sig; prompt_sigint = 1; }
+static void on_sigwinch(int sig) { (void)sig; prompt_sigwinch = 1; }
+
+static void on_line(char *line)
+{
+  cb_line = line;
+  cb_done = 1;
+  rl_callback_handler_remove();
+}
+
+/* Read a line with Readline.  Returns 1 and sets *line (malloc'ed, NULL on
+ * EOF); returns 0 when Ctrl-C cleared the line. */
+static int rl_getline(const char *prompt, char **line)
+{
+  struct sigaction sa, oldint, oldwinch;
+  int interrupted = 0;
+  memset(&sa, 0, sizeof sa);
+  sigemptyset(&sa.sa_mask);
+  sa.sa_handler = on_sigint;           /* no SA_RESTART: poll returns EINTR */
+  sigaction(SIGINT, &sa, &oldint);
+  sa.sa_handler = on_sigwinch;
+  sigaction(SIGWINCH, &sa, &oldwinch);
+  prompt_sigint = 0;
+  cb_done = 0;
+  cb_line = NULL;
+  rl_callback_handler_install(prompt, on_line);
+  while (!cb_done) {
+    struct pollfd pfd = {fileno(rl_instream), POLLIN, 0};
+    int r = poll(&pfd, 1, -1);
+    if (prompt_sigwinch) {
+      prompt_sigwinch = 0;
+      rl_resize_terminal();
+    }
+    if (prompt_sigint) {
+      prompt_sigint = 0;
+      rl_free_line_state();
+      rl_callback_sigcleanup();
+      rl_replace_line("", 0);
+      rl_point = rl_end = 0;
+      rl_crlf();
+      rl_callback_handler_remove();
+      interrupted = 1;
+      break;
+    }
+    if (r < 0) {
+      if (errno == EINTR)
+        continue;
+      on_line(NULL);
+      break;
+    }
+    rl_callback_read_char();
+  }
+  sigaction(SIGINT, &oldint, NULL);
+  sigaction(SIGWINCH, &oldwinch, NULL);
+  *line = interrupted ? NULL : cb_line;
+  return !interrupted;
+}
+#endif
+
+static const char *get_prompt(lua_State *L, int firstline)
+{
+  if (lua_getglobal(L, firstline ? "_PROMPT" : "_PROMPT2") == LUA_TNIL)
+    return firstline ? PROMPT1 : PROMPT2;
+  return luaL_tolstring(L, -1, NULL);   /* leaves two values on the stack */
+}
+
+/* Push the next input line (without its newline).  Returns 0 at end of
+ * input, -1 when Ctrl-C discarded the line, 1 otherwise. */
+static int pushline(lua_State *L, int firstline)
+{
+  const char *prompt;
+  char *b;
+  size_t l;
+  int top = lua_gettop(L);
+  prompt = get_prompt(L, firstline);
+#ifdef HAVE_READLINE
+  if (use_readline) {
+    int ok = rl_getline(prompt, &b);
+    lua_settop(L, top);
+    if (!ok)
+      return -1;
+    if (b == NULL)
+      return 0;
+    lua_pushstring(L, b);
+    free(b);
+    return 1;
+  }
+#endif
+  {
+    char buffer[MAXINPUT];
+    luaL_Buffer lb;
+    fputs(prompt, stdout);
+    fflush(stdout);
+    lua_settop(L, top);
+    luaL_buffinit(L, &lb);
+    for (;;) {
+      if (fgets(buffer, sizeof buffer, stdin) == NULL) {
+        if (luaL_bufflen(&lb) == 0) {
+          luaL_pushresult(&lb);
+          lua_pop(L, 1);
+          return 0;
+        }
+        break;
+      }
+      l = strlen(buffer);
+      if (l > 0 && buffer[l - 1] == '\n') {
+        luaL_addlstring(&lb, buffer, l - 1);
+        break;
+      }
+      luaL_addlstring(&lb, buffer, l);
+    }
+    luaL_pushresult(&lb);
+    return 1;
+  }
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * history
+ * ======================================================================= */
+
+#ifdef HAVE_READLINE
+static int mkdirs(char *path)
+{
+  char *p;
+  for (p = path + 1; *p; p++) {
+    if (*p == '/') {
+      *p = '\0';
+      if (mkdir(path, 0700) != 0 && errno != EEXIST) {
+        *p = '/';
+        return -1;
+      }
+      *p = '/';
+    }
+  }
+  return 0;
+}
+
+static void history_open(void)
+{
+  const char *state = getenv("XDG_STATE_HOME"), *home = getenv("HOME");
+  size_t len;
+  int fd;
+  if (state != NULL && *state == '/') {
+    len = strlen(state) + sizeof "/dmech/history";
+    history_path = malloc(len);
+    if (history_path == NULL)
+      return;
+    snprintf(history_path, len, "%s/dmech/history", state);
+    if (mkdirs(history_path) != 0) {
+      free(history_path);
+      history_path = NULL;
+      return;
+    }
+  } else if (home != NULL && *home != '\0') {
+    len = strlen(home) + sizeof "/.dmech_history";
+    history_path = malloc(len);
+    if (history_path == NULL)
+      return;
+    snprintf(history_path, len, "%s/.dmech_history", home);
+  } else {
+    return;
+  }
+  /* Timestamps delimit entries, so a multi-line chunk reads back as one. */
+  history_write_timestamps = 1;
+  history_multiline_entries = 1;
+  fd = open(history_path, O_WRONLY | O_CREAT | O_APPEND, 0600);
+  if (fd >= 0)
+    close(fd);
+  read_history(history_path);
+}
+
+static void history_add(const char *entry)
+{
+  if (entry[0] == '\0')
+    return;
+  add_history(entry);
+  if (history_path != NULL) {
+    append_history(1, history_path);
+    if (history_length > HISTORY_KEEP + HISTORY_KEEP / 10)
+      history_truncate_file(history_path, HISTORY_KEEP);
+  }
+}
+#endif
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * reading and running chunks
+ * ======================================================================= */
+
+#define EOFMARK "<eof>"
+#define marklen (sizeof(EOFMARK) / sizeof(char) - 1)
+
+static int incomplete(lua_State *L, int status)
+{
+  if (status == LUA_ERRSYNTAX) {
+    size_t lmsg;
+    const char *msg = lua_tolstring(L, -1, &lmsg);
+    if (lmsg >= marklen && strcmp(msg + lmsg - marklen, EOFMARK) == 0) {
+      lua_pop(L, 1);
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* Does the chunk end with ';' (ignoring trailing blanks)? */
+static int ends_with_semicolon(const char *s, size_t l)
+{
+  while (l > 0 && (s[l - 1] == ' ' || s[l - 1] == '\t' || s[l - 1] == '\r'))
+    l--;
+  return l > 0 && s[l - 1] == ';';
+}
+
+/* Try to compile the line on the stack as "return <line>". */
+static int addreturn(lua_State *L)
+{
+  const char *line = lua_tostring(L, -1);
+  const char *retline = lua_pushfstring(L, "return %s;", line);
+  int status = luaL_loadbuffer(L, retline, strlen(retline), "=stdin");
+  if (status == LUA_OK)
+    lua_remove(L, -2);
+  else
+    lua_pop(L, 2);
+  return status;
+}
+
+/* Read more lines while the chunk is incomplete; 0 ok, -1 cancelled. */
+static int multiline(lua_State *L)
+{
+  for (;;) {
+    size_t len;
+    const char *line = lua_tolstring(L, 1, &len);
+    int status = luaL_loadbuffer(L, line, len, "=stdin");
+    int r;
+    if (!incomplete(L, status))
+      return status;
+    r = pushline(L, 0);
+    if (r <= 0) {
+      if (r == 0)    /* end of input inside a chunk: report the syntax error */
+        return luaL_loadbuffer(L, line, len, "=stdin");
+      lua_settop(L, 0);
+      return -1;
+    }
+    lua_pushliteral(L, "\n");
+    lua_insert(L, -2);
+    lua_concat(L, 3);
+  }
+}
+
+/* Read a whole chunk; on success the stack is [line, function]; returns the
+ * load status, -1 on end of input, -2 when Ctrl-C cancelled the input.  *expr
+ * tells whether the chunk is an expression (its results are printed). */
+static int loadline(lua_State *L, int *expr, int *quiet)
+{
+  int status, r;
+  size_t len;
+  const char *line;
+  lua_settop(L, 0);
+  r = pushline(L, 1);
+  if (r == 0)
+    return -1;
+  if (r < 0)
+    return -2;
+  line = lua_tolstring(L, 1, &len);
+  if (len > 0 && line[0] == '=') {          /* "=expr" as in Lua 5.1 */
+    lua_pushfstring(L, "%s", line + 1);
+    lua_replace(L, 1);
+  }
+  *expr = 1;
+  if ((status = addreturn(L)) != LUA_OK) {
+    *expr = 0;
+    status = multiline(L);
+    if (status == -1)
+      return -2;
+  }
+  line = lua_tolstring(L, 1, &len);
+  *quiet = ends_with_semicolon(line, len);
+#ifdef HAVE_READLINE
+  if (use_readline)
+    history_add(line);
+#endif
+  return status;
+}
+
+/* Print the results on the stack through dmech.print (pretty printer). */
+static void print_results(lua_State *L)
+{
+  int n = lua_gettop(L);
+  if (n == 0)
+    return;
+  luaL_checkstack(L, LUA_MINSTACK, "too many results to print");
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech.print");
+  if (lua_pcall(L, 1, 1, 0) != LUA_OK || lua_getfield(L, -1, "results") != LUA_TFUNCTION) {
+    lua_settop(L, n);                      /* fall back to plain print */
+    lua_getglobal(L, "print");
+  } else {
+    lua_remove(L, -2);
+  }
+  lua_insert(L, 1);
+  if (dm_docall(L, n, 0) != LUA_OK)
+    dm_report(L, LUA_ERRRUN);
+}
+
+void dm_repl(lua_State *L)
+{
+  int status, expr = 0, quiet = 0;
+#ifdef HAVE_READLINE
+  use_readline = isatty(STDIN_FILENO);
+  if (use_readline) {
+    rl_readline_name = DM_PROGNAME;
+    rl_catch_signals = 0;
+    rl_catch_sigwinch = 0;
+    dm_complete_init(L);
+    history_open();
+  }
+#endif
+  for (;;) {
+    status = loadline(L, &expr, &quiet);
+    if (status == -1)
+      break;
+    if (status == -2)
+      continue;
+    lua_remove(L, 1);                        /* the line text */
+    if (status == LUA_OK)
+      status = dm_docall(L, 0, LUA_MULTRET);
+    if (status == LUA_OK) {
+      if (expr && lua_gettop(L) > 0) {
+        lua_pushvalue(L, 1);
+        lua_setglobal(L, "_");
+      }
+      if (!quiet)
+        print_results(L);
+    } else {
+      dm_report(L, status);
+    }
+  }
+  lua_settop(L, 0);
+  if (use_readline || isatty(STDIN_FILENO))
+    fputs("\n", stdout);
+  fflush(stdout);
+#ifdef HAVE_READLINE
+  free(history_path);
+  history_path = NULL;
+#endif
+}
+
+/* }====================================================================== */

@@ -1,0 +1,130 @@
+/* dmlua.h -- what every dmech Lua binding shares.
+ *
+ * Bindings (src/lua/l*.c) turn C objects into userdata, check arguments and
+ * turn dm statuses into Lua errors.  They never compute.  Patterns:
+ *
+ *  - Every exposed function or method is registered through a dm_reg table
+ *    carrying a one-line signature and one sentence of documentation; the
+ *    registry behind help()/apropos() is filled as a side effect, and a test
+ *    fails when something reachable from `dm` has no entry.
+ *  - Userdata are created empty with their metatable set before anything is
+ *    allocated (liolib style); __gc and __close share one idempotent cleanup.
+ *  - Numeric arguments accept a dm.vec or a Lua table of numbers:
+ *    dm_checkvector() converts a table in place (the argument slot then holds a
+ *    new vec), so memory is always owned by Lua and an error can never leak.
+ */
+#ifndef DM_LUA_H
+#define DM_LUA_H
+
+#include <lua.h>
+#include <lauxlib.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_vector.h>
+
+#include "core/status.h"
+
+#define DM_VEC_MT "dmech.vec"
+#define DM_MAT_MT "dmech.mat"
+
+/* ---- documented registration -------------------------------------------- */
+
+typedef struct dm_reg {
+  const char *name;
+  lua_CFunction func;
+  const char *sig;   /* "dm.vec(n | {x1,...} | x1, x2, ...) -> vec" */
+  const char *doc;   /* one sentence */
+} dm_reg;
+
+/* Put the functions of `regs` (terminated by a NULL name) into the table at
+ * the top of the stack and record their documentation under
+ * "<prefix><name>" (prefix "dm." for module functions, "vec:" for methods). */
+void dm_register(lua_State *L, const char *prefix, const dm_reg *regs);
+
+/* Record documentation for `name`; if the value at `idx` is a function (or
+ * any non-nil value) it is also indexed by identity so help(value) finds it.
+ * idx 0 means no value. */
+void dm_doc_add(lua_State *L, const char *name, const char *sig,
+                const char *doc, int idx);
+
+/* Create the metatable `tname` for a class whose methods are documented as
+ * "<kind>:<method>"; `methods` becomes __index (unless `meta` sets __index),
+ * `meta` supplies metamethods (undocumented).  Leaves the metatable on the
+ * stack. */
+void dm_newclass(lua_State *L, const char *tname, const char *kind,
+                 const dm_reg *methods, const luaL_Reg *meta);
+
+/* Push the docs registry table (name -> {sig=, doc=}). */
+void dm_pushdocs(lua_State *L);
+
+/* ---- errors ------------------------------------------------------------------ */
+
+/* Raise a Lua error "<what>: <message>" for a failed dm status; `e` may be
+ * NULL or have an empty message, then the status name is used. */
+int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e);
+
+/* luaL_typeerror-style message with a free-form expectation:
+ * "bad argument #arg to 'f' (<expected> expected, got <actual>)". */
+int dm_argexpected(lua_State *L, int arg, const char *expected,
+                   const char *actual);
+
+/* Option value from the table at index t: number field `key` or default;
+ * raises "bad argument #t to 'f' (field 'key': number expected, got X)". */
+double dm_optnumberfield(lua_State *L, int t, const char *key, double def);
+lua_Integer dm_optintegerfield(lua_State *L, int t, const char *key,
+                               lua_Integer def);
+const char *dm_optstringfield(lua_State *L, int t, const char *key,
+                              const char *def);
+
+/* Shortest decimal that reads back as exactly x ("2.385", "0.1", "1e-300"),
+ * locale independent; returns the length. */
+int dm_fmtnum(char *buf, size_t size, double x);
+
+/* ---- vectors and matrices -------------------------------------------------- */
+
+/* A vec userdata: a gsl_vector whose data live in the userdata itself or, for
+ * a view (row of a matrix), in the object held by user value 1. */
+typedef struct dm_lvec {
+  gsl_vector v;
+} dm_lvec;
+
+typedef struct dm_lmat {
+  gsl_matrix m;
+} dm_lmat;
+
+/* New zero vector / matrix userdata pushed on the stack. */
+gsl_vector *dm_pushvec(lua_State *L, size_t n);
+gsl_matrix *dm_pushmat(lua_State *L, size_t rows, size_t cols);
+/* Push a copy of a C array / GSL object as a new vec / mat. */
+gsl_vector *dm_pushvec_copy(lua_State *L, const double *x, size_t n);
+gsl_matrix *dm_pushmat_copy(lua_State *L, const gsl_matrix *src);
+
+/* The vec / mat at arg, or NULL when it is something else. */
+gsl_vector *dm_tovec(lua_State *L, int arg);
+gsl_matrix *dm_tomat(lua_State *L, int arg);
+/* The vec / mat at arg or raise an argument error. */
+gsl_vector *dm_checkvec(lua_State *L, int arg);
+gsl_matrix *dm_checkmat(lua_State *L, int arg);
+
+/* Accept a vec or a sequence table of numbers at arg (a table is converted in
+ * place to a new vec).  n == 0 accepts any non-empty length; otherwise the
+ * length must equal n.  The result always has stride 1. */
+gsl_vector *dm_checkvector(lua_State *L, int arg, size_t n);
+/* Same for matrices: a mat or a table of equal-length row tables. */
+gsl_matrix *dm_checkmatrix(lua_State *L, int arg, size_t rows, size_t cols);
+
+/* Open the vec/mat classes and put dm.vec, dm.mat, ... into the table at the
+ * top of the stack. */
+void dm_open_doc(lua_State *L);      /* dm.docs, dm.doc */
+void dm_open_linalg(lua_State *L);
+void dm_open_mat(lua_State *L);   /* part of dm_open_linalg */
+
+/* ---- module opener ------------------------------------------------------------ */
+
+/* Fill the `dm` table at the top of the stack with every binding module. */
+void dm_open_all(lua_State *L);
+
+/* luaopen_dmech: the C part of `require "dmech"`; loads the Lua-side library
+ * (dmech.init) on top of it. */
+int luaopen_dmech(lua_State *L);
+
+#endif

@@ -1,0 +1,97 @@
+/* laux.c -- argument checking and error helpers shared by the bindings. */
+#include <config.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dmlua.h"
+
+int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e)
+{
+  const char *msg = (e != NULL && e->msg[0] != '\0') ? e->msg : dm_strstatus(status);
+  return luaL_error(L, "%s: %s", what, msg);
+}
+
+int dm_argexpected(lua_State *L, int arg, const char *expected,
+                   const char *actual)
+{
+  const char *msg = lua_pushfstring(L, "%s expected, got %s", expected, actual);
+  return luaL_argerror(L, arg, msg);
+}
+
+static int fielderror(lua_State *L, int t, const char *key, const char *want)
+{
+  const char *msg = lua_pushfstring(L, "field '%s': %s expected, got %s", key,
+                                    want, luaL_typename(L, -2));
+  return luaL_argerror(L, t, msg);
+}
+
+double dm_optnumberfield(lua_State *L, int t, const char *key, double def)
+{
+  double x;
+  int isnum;
+  if (lua_getfield(L, t, key) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return def;
+  }
+  x = lua_tonumberx(L, -1, &isnum);
+  if (!isnum)
+    return fielderror(L, t, key, "number");
+  lua_pop(L, 1);
+  return x;
+}
+
+lua_Integer dm_optintegerfield(lua_State *L, int t, const char *key,
+                               lua_Integer def)
+{
+  lua_Integer k;
+  int isnum;
+  if (lua_getfield(L, t, key) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return def;
+  }
+  k = lua_tointegerx(L, -1, &isnum);
+  if (!isnum)
+    return fielderror(L, t, key, "integer");
+  lua_pop(L, 1);
+  return k;
+}
+
+/* The returned string stays valid: it is anchored in the table at t. */
+const char *dm_optstringfield(lua_State *L, int t, const char *key,
+                              const char *def)
+{
+  const char *s;
+  if (lua_getfield(L, t, key) == LUA_TNIL) {
+    lua_pop(L, 1);
+    return def;
+  }
+  if (lua_type(L, -1) != LUA_TSTRING) {
+    fielderror(L, t, key, "string");
+    return NULL;
+  }
+  s = lua_tostring(L, -1);
+  lua_pop(L, 1);
+  return s;
+}
+
+int dm_fmtnum(char *buf, size_t size, double x)
+{
+  int prec, len = 0;
+  char *p;
+  if (x != x)
+    return snprintf(buf, size, "nan");
+  if (x == HUGE_VAL || x == -HUGE_VAL)
+    return snprintf(buf, size, x > 0 ? "inf" : "-inf");
+  for (prec = 15; prec <= 17; prec++) {
+    len = snprintf(buf, size, "%.*g", prec, x);
+    if (strtod(buf, NULL) == x)
+      break;
+  }
+  /* Programs that set LC_NUMERIC could give a decimal comma: undo it. */
+  for (p = buf; *p != '\0'; p++)
+    if (*p == ',')
+      *p = '.';
+  return len;
+}

@@ -1,0 +1,130 @@
+/* ldoc.c -- the documentation registry behind help() and apropos().
+ *
+ * Two tables live in the Lua registry: "dmech.docs" maps a qualified name
+ * ("dm.vec", "vec:dot") to {name=, sig=, doc=}; "dmech.docvals" (weak keys)
+ * maps a documented value (a C function) to the same record, so help(v.dot)
+ * works without knowing names.
+ */
+#include <config.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "dmlua.h"
+
+static void pushregtable(lua_State *L, const char *key, const char *mode)
+{
+  if (lua_getfield(L, LUA_REGISTRYINDEX, key) == LUA_TTABLE)
+    return;
+  lua_pop(L, 1);
+  lua_newtable(L);
+  if (mode != NULL) {
+    lua_newtable(L);
+    lua_pushstring(L, mode);
+    lua_setfield(L, -2, "__mode");
+    lua_setmetatable(L, -2);
+  }
+  lua_pushvalue(L, -1);
+  lua_setfield(L, LUA_REGISTRYINDEX, key);
+}
+
+void dm_pushdocs(lua_State *L)
+{
+  pushregtable(L, "dmech.docs", NULL);
+}
+
+void dm_doc_add(lua_State *L, const char *name, const char *sig,
+                const char *doc, int idx)
+{
+  if (idx != 0)
+    idx = lua_absindex(L, idx);
+  dm_pushdocs(L);
+  lua_createtable(L, 0, 3);
+  lua_pushstring(L, name);
+  lua_setfield(L, -2, "name");
+  lua_pushstring(L, sig != NULL ? sig : name);
+  lua_setfield(L, -2, "sig");
+  lua_pushstring(L, doc != NULL ? doc : "");
+  lua_setfield(L, -2, "doc");
+  lua_pushvalue(L, -1);
+  lua_setfield(L, -3, name);                 /* docs[name] = rec */
+  if (idx != 0 && !lua_isnil(L, idx)) {
+    pushregtable(L, "dmech.docvals", "k");
+    lua_pushvalue(L, idx);
+    lua_pushvalue(L, -3);
+    lua_rawset(L, -3);                        /* docvals[value] = rec */
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 2);
+}
+
+void dm_register(lua_State *L, const char *prefix, const dm_reg *regs)
+{
+  luaL_Buffer b;
+  for (; regs->name != NULL; regs++) {
+    lua_pushcfunction(L, regs->func);
+    luaL_buffinit(L, &b);
+    luaL_addstring(&b, prefix);
+    luaL_addstring(&b, regs->name);
+    luaL_pushresult(&b);
+    dm_doc_add(L, lua_tostring(L, -1), regs->sig, regs->doc, -2);
+    lua_pop(L, 1);
+    lua_setfield(L, -2, regs->name);
+  }
+}
+
+void dm_newclass(lua_State *L, const char *tname, const char *kind,
+                 const dm_reg *methods, const luaL_Reg *meta)
+{
+  char prefix[64];
+  luaL_newmetatable(L, tname);
+  snprintf(prefix, sizeof prefix, "%s:", kind);
+  if (meta != NULL)
+    luaL_setfuncs(L, meta, 0);
+  lua_pushstring(L, kind);
+  lua_setfield(L, -2, "__name");
+  if (methods != NULL) {
+    lua_newtable(L);
+    dm_register(L, prefix, methods);
+    if (lua_getfield(L, -2, "__index") == LUA_TNIL) {
+      lua_pop(L, 1);
+      lua_pushvalue(L, -1);
+      lua_setfield(L, -3, "__index");
+    } else {
+      lua_pop(L, 1);
+    }
+    lua_setfield(L, -2, "__methods");   /* for completion and the doc test */
+  }
+}
+
+/* {======================================================================
+ * Lua access to the registry (used by lua/dmech/help.lua and the doc test)
+ * ======================================================================= */
+
+static int l_docs(lua_State *L)
+{
+  dm_pushdocs(L);
+  pushregtable(L, "dmech.docvals", "k");
+  return 2;
+}
+
+static int l_doc(lua_State *L)
+{
+  const char *name = luaL_checkstring(L, 1);
+  const char *sig = luaL_checkstring(L, 2);
+  const char *doc = luaL_checkstring(L, 3);
+  dm_doc_add(L, name, sig, doc, lua_isnoneornil(L, 4) ? 0 : 4);
+  return 0;
+}
+
+static const dm_reg doc_funcs[] = {
+  {"docs", l_docs, "dm.docs() -> by_name, by_value",
+   "The documentation registry: name -> {name, sig, doc}, and documented value -> the same record."},
+  {"doc", l_doc, "dm.doc(name, signature, sentence[, value])",
+   "Add an entry to the documentation registry (for Lua-side functions and user libraries)."},
+  {NULL, NULL, NULL, NULL}
+};
+
+void dm_open_doc(lua_State *L)
+{
+  dm_register(L, "dm.", doc_funcs);
+}

@@ -1,0 +1,20 @@
+/* linit.c -- the list of binding modules that make up the `dm` table.
+ * A new binding module adds one line to `openers`. */
+#include <config.h>
+
+#include "dmlua.h"
+
+typedef void (*dm_opener)(lua_State *L);
+
+static const dm_opener openers[] = {
+  dm_open_doc,
+  dm_open_linalg,
+  NULL
+};
+
+void dm_open_all(lua_State *L)
+{
+  const dm_opener *o;
+  for (o = openers; *o != NULL; o++)
+    (*o)(L);
+}

@@ -1,0 +1,70 @@
+/* module.c -- luaopen_dmech: the C side of `require "dmech"`.
+ *
+ * Used twice: linked into the dmech program (where it is preloaded) and built
+ * as the Lua C module dmech.so for stock lua5.4.  It builds the table of C
+ * functions, makes the Lua-side library findable (DMECH_PATH first, then the
+ * installed data directory, then the source tree it was built from) and hands
+ * the table to dmech.init, whose result is the module.
+ */
+#include <config.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dmlua.h"
+
+/* Prepend "<dir>/?.lua" for every directory we search to package.path, once. */
+static void setpath(lua_State *L)
+{
+  luaL_Buffer b;
+  const char *env = getenv("DMECH_PATH");
+  lua_getglobal(L, "package");
+  if (!lua_istable(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (lua_getfield(L, -1, "dmech_path_set") != LUA_TNIL) {
+    lua_pop(L, 2);
+    return;
+  }
+  lua_pop(L, 1);
+  luaL_buffinit(L, &b);
+  if (env != NULL && *env != '\0') {
+    const char *p = env, *q;
+    for (;;) {
+      q = strchr(p, ':');
+      size_t len = q != NULL ? (size_t)(q - p) : strlen(p);
+      if (len > 0) {
+        luaL_addlstring(&b, p, len);
+        luaL_addstring(&b, "/?.lua;");
+      }
+      if (q == NULL)
+        break;
+      p = q + 1;
+    }
+  }
+  luaL_addstring(&b, DMECH_LUADIR "/?.lua;" DMECH_SRC_LUADIR "/?.lua;");
+  lua_getfield(L, -2, "path");
+  luaL_addvalue(&b);
+  luaL_pushresult(&b);
+  lua_setfield(L, -2, "path");
+  lua_pushboolean(L, 1);
+  lua_setfield(L, -2, "dmech_path_set");
+  lua_pop(L, 1);
+}
+
+int luaopen_dmech(lua_State *L)
+{
+  dm_gsl_init();
+  setpath(L);
+  lua_newtable(L);
+  dm_open_all(L);
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "loaded");
+  lua_pushvalue(L, -3);
+  lua_setfield(L, -2, "dmech.core");       /* package.loaded["dmech.core"] = C table */
+  lua_pop(L, 2);
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech.init");
+  lua_call(L, 1, 1);
+  return 1;
+}
