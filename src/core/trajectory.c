@@ -1,0 +1,743 @@
+/* trajectory.c -- columnar storage of a run: columns, samples, derived
+ * columns, slicing, metadata.  The CSV files are in trajectory_csv.c. */
+#include <config.h>
+#include "trajectory.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interrupt.h"
+
+typedef struct column {
+  char *name;
+  int kind;
+  double *x;          /* capacity >= tr->cap values (NULL while cap == 0) */
+} column;
+
+struct dm_traj {
+  size_t n;           /* coordinates */
+  unsigned flags;     /* DM_TRAJ_WITH_* */
+  size_t nstate;      /* 1 + n * (1 + has p + has v): first extra column */
+  column *cols;
+  size_t ncols, colcap;
+  size_t len, cap;    /* samples stored, samples every column can hold */
+  char **mkey, **mval;
+  size_t nmeta, metacap;
+};
+
+static char *dupstr(const char *s)
+{
+  size_t k = strlen(s) + 1;
+  char *d = malloc(k);
+  if (d != NULL)
+    memcpy(d, s, k);
+  return d;
+}
+
+/* {==== names ============================================================ */
+
+static int valid_name(const char *s)
+{
+  size_t k;
+  if (s == NULL || s[0] == '\0')
+    return 0;
+  for (k = 0; s[k] != '\0'; k++) {
+    unsigned char c = (unsigned char)s[k];
+    if (k >= DM_TRAJ_NAME_MAX || c < 0x20 || c == 0x7f || c == ' '
+        || c == ',' || c == '"' || c == '\'')
+      return 0;
+  }
+  return 1;
+}
+
+static int bad_name(dm_err *e, const char *what, const char *s)
+{
+  if (s == NULL)
+    return dm_err_set(e, DM_EINVAL, "%s name missing", what);
+  return dm_err_set(e, DM_EINVAL, "invalid %s name '%.*s' (1 to %d bytes, "
+                    "no spaces, commas, quotes or control characters)", what,
+                    DM_TRAJ_NAME_MAX + 8, s, DM_TRAJ_NAME_MAX);
+}
+
+size_t dm_traj_find(const dm_traj *tr, const char *name)
+{
+  size_t j;
+  if (tr == NULL || name == NULL)
+    return DM_TRAJ_NONE;
+  for (j = 0; j < tr->ncols; j++)
+    if (strcmp(tr->cols[j].name, name) == 0)
+      return j;
+  return DM_TRAJ_NONE;
+}
+
+char *dm_traj_names(const dm_traj *tr, char *buf, size_t size)
+{
+  size_t j, used = 0;
+  if (size == 0)
+    return buf;
+  buf[0] = '\0';
+  for (j = 0; j < tr->ncols; j++) {
+    const char *sep = j > 0 ? ", " : "";
+    size_t need = strlen(sep) + strlen(tr->cols[j].name);
+    /* the last name needs its own room; others also room for ", ..." */
+    size_t room = need + 1 + (j + 1 < tr->ncols ? 5 : 0);
+    if (used + room > size) {
+      if (used + 6 <= size)
+        strcpy(buf + used, j > 0 ? ", ..." : "...");
+      break;
+    }
+    used += (size_t)snprintf(buf + used, size - used, "%s%s", sep,
+                             tr->cols[j].name);
+  }
+  return buf;
+}
+
+int dm_traj_lookup(const dm_traj *tr, const char *name, size_t *j, dm_err *e)
+{
+  char list[DM_ERRMSG_MAX - 64];
+  size_t k = dm_traj_find(tr, name);
+  if (k == DM_TRAJ_NONE)
+    return dm_err_set(e, DM_ENOTFOUND, "no column '%.100s' (available: %s)",
+                      name != NULL ? name : "(null)",
+                      dm_traj_names(tr, list, sizeof list));
+  if (j != NULL)
+    *j = k;
+  return DM_OK;
+}
+
+/* }==== */
+
+/* {==== life cycle ======================================================= */
+
+/* Append a column named prefix+name (not yet allocated: x == NULL). */
+static int push_col(dm_traj *tr, const char *prefix, const char *name,
+                    int kind, dm_err *e)
+{
+  size_t lp = strlen(prefix), ln = strlen(name);
+  char *s;
+  if (tr->ncols == tr->colcap) {
+    size_t nc = tr->colcap ? 2 * tr->colcap : 8;
+    column *c = realloc(tr->cols, nc * sizeof *c);
+    if (c == NULL)
+      return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory for columns");
+    tr->cols = c;
+    tr->colcap = nc;
+  }
+  s = malloc(lp + ln + 1);
+  if (s == NULL)
+    return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory for names");
+  memcpy(s, prefix, lp);
+  memcpy(s + lp, name, ln + 1);
+  if (!valid_name(s)) {
+    int st = bad_name(e, "column", s);
+    free(s);
+    return st;
+  }
+  if (dm_traj_find(tr, s) != DM_TRAJ_NONE) {
+    dm_err_set(e, DM_EINVAL, "column name '%s' is used twice", s);
+    free(s);
+    return DM_EINVAL;
+  }
+  tr->cols[tr->ncols].name = s;
+  tr->cols[tr->ncols].kind = kind;
+  tr->cols[tr->ncols].x = NULL;
+  tr->ncols++;
+  return DM_OK;
+}
+
+dm_traj *dm_traj_alloc(size_t n, const char *const *coords, unsigned flags,
+                       dm_err *e)
+{
+  static const char *const pre[3] = {"", "p_", "v_"};
+  static const int kinds[3] = {DM_TRAJ_Q, DM_TRAJ_P, DM_TRAJ_V};
+  dm_traj *tr;
+  size_t i, pass;
+  int st = DM_OK;
+
+  if (flags & ~(unsigned)(DM_TRAJ_WITH_P | DM_TRAJ_WITH_V)) {
+    dm_err_set(e, DM_EINVAL, "trajectory: unknown flags 0x%x", flags);
+    return NULL;
+  }
+  if (n > 1000000) {
+    dm_err_set(e, DM_EINVAL, "trajectory: %zu coordinates is too many", n);
+    return NULL;
+  }
+  tr = calloc(1, sizeof *tr);
+  if (tr == NULL) {
+    dm_err_set(e, DM_ENOMEM, "trajectory: out of memory");
+    return NULL;
+  }
+  tr->n = n;
+  tr->flags = flags;
+  st = push_col(tr, "", "t", DM_TRAJ_T, e);
+  for (pass = 0; pass < 3 && st == DM_OK; pass++) {
+    if ((pass == 1 && !(flags & DM_TRAJ_WITH_P))
+        || (pass == 2 && !(flags & DM_TRAJ_WITH_V)))
+      continue;
+    for (i = 0; i < n && st == DM_OK; i++) {
+      char def[32];
+      const char *name = def;
+      if (coords != NULL) {
+        name = coords[i];
+        if (!valid_name(name)
+            || (pass == 0 && strlen(name) > DM_TRAJ_NAME_MAX - 2)) {
+          st = bad_name(e, "coordinate", name);
+          break;
+        }
+      } else {
+        snprintf(def, sizeof def, "q%zu", i + 1);
+      }
+      st = push_col(tr, pre[pass], name, kinds[pass], e);
+    }
+  }
+  if (st != DM_OK) {
+    dm_traj_free(tr);
+    return NULL;
+  }
+  tr->nstate = tr->ncols;
+  return tr;
+}
+
+void dm_traj_free(dm_traj *tr)
+{
+  size_t j;
+  if (tr == NULL)
+    return;
+  for (j = 0; j < tr->ncols; j++) {
+    free(tr->cols[j].name);
+    free(tr->cols[j].x);
+  }
+  free(tr->cols);
+  for (j = 0; j < tr->nmeta; j++) {
+    free(tr->mkey[j]);
+    free(tr->mval[j]);
+  }
+  free(tr->mkey);
+  free(tr->mval);
+  free(tr);
+}
+
+/* Grow every column to hold at least `need` samples.  A failure part way
+ * leaves some columns larger than tr->cap, which is harmless: the data are
+ * intact and the next attempt reallocates to at least the same size. */
+static int grow(dm_traj *tr, size_t need, dm_err *e)
+{
+  size_t j, nc;
+  if (need <= tr->cap)
+    return DM_OK;
+  nc = tr->cap < 16 ? 16 : tr->cap;
+  while (nc < need)
+    nc = nc > SIZE_MAX / 2 ? need : 2 * nc;
+  if (nc > SIZE_MAX / sizeof(double))
+    return dm_err_set(e, DM_ENOMEM, "trajectory: %zu samples is too many", need);
+  for (j = 0; j < tr->ncols; j++) {
+    double *x = realloc(tr->cols[j].x, nc * sizeof *x);
+    if (x == NULL)
+      return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory growing "
+                        "to %zu samples (%zu kept)", nc, tr->len);
+    tr->cols[j].x = x;
+  }
+  tr->cap = nc;
+  return DM_OK;
+}
+
+int dm_traj_reserve(dm_traj *tr, size_t nsamples, dm_err *e)
+{
+  size_t j, nc = nsamples;
+  if (nc <= tr->cap)
+    return DM_OK;
+  if (nc > SIZE_MAX / sizeof(double))
+    return dm_err_set(e, DM_ENOMEM, "trajectory: %zu samples is too many", nc);
+  for (j = 0; j < tr->ncols; j++) {
+    double *x = realloc(tr->cols[j].x, nc * sizeof *x);
+    if (x == NULL)
+      return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory reserving "
+                        "%zu samples", nc);
+    tr->cols[j].x = x;
+  }
+  tr->cap = nc;
+  return DM_OK;
+}
+
+void dm_traj_clear(dm_traj *tr)
+{
+  tr->len = 0;
+}
+
+/* }==== */
+
+/* {==== appending and access ============================================ */
+
+int dm_traj_append(dm_traj *tr, double t, const double *q, const double *p,
+                   const double *v, const double *extra, dm_err *e)
+{
+  size_t i, j, k = tr->len, n = tr->n;
+  column *c;
+  int st;
+  if (n > 0 && q == NULL)
+    return dm_err_set(e, DM_EINVAL, "trajectory append: q missing");
+  if (k == tr->cap && (st = grow(tr, k + 1, e)) != DM_OK)
+    return st;
+  c = tr->cols;
+  c[0].x[k] = t;
+  for (i = 0; i < n; i++)
+    c[1 + i].x[k] = q[i];
+  j = 1 + n;
+  if (tr->flags & DM_TRAJ_WITH_P) {
+    for (i = 0; i < n; i++)
+      c[j + i].x[k] = p != NULL ? p[i] : NAN;
+    j += n;
+  }
+  if (tr->flags & DM_TRAJ_WITH_V) {
+    for (i = 0; i < n; i++)
+      c[j + i].x[k] = v != NULL ? v[i] : NAN;
+    j += n;
+  }
+  for (i = 0; j + i < tr->ncols; i++)
+    c[j + i].x[k] = extra != NULL ? extra[i] : NAN;
+  tr->len = k + 1;
+  return DM_OK;
+}
+
+int dm_traj_sink(void *ctx, double t, const double *q, const double *p,
+                 const double *v)
+{
+  return dm_traj_append((dm_traj *)ctx, t, q, p, v, NULL, NULL);
+}
+
+size_t dm_traj_len(const dm_traj *tr) { return tr->len; }
+size_t dm_traj_ncoords(const dm_traj *tr) { return tr->n; }
+size_t dm_traj_ncols(const dm_traj *tr) { return tr->ncols; }
+unsigned dm_traj_flags(const dm_traj *tr) { return tr->flags; }
+
+const char *dm_traj_coord(const dm_traj *tr, size_t i)
+{
+  return i < tr->n ? tr->cols[1 + i].name : NULL;
+}
+
+const char *dm_traj_colname(const dm_traj *tr, size_t j)
+{
+  return j < tr->ncols ? tr->cols[j].name : NULL;
+}
+
+int dm_traj_colkind(const dm_traj *tr, size_t j)
+{
+  return j < tr->ncols ? tr->cols[j].kind : -1;
+}
+
+const double *dm_traj_col(const dm_traj *tr, size_t j)
+{
+  return j < tr->ncols ? tr->cols[j].x : NULL;
+}
+
+const char *dm_traj_kindname(int kind)
+{
+  static const char *const names[] = {"t", "q", "p", "v", "diag", "derived",
+                                      "data"};
+  if (kind < 0 || kind > DM_TRAJ_DATA)
+    return "?";
+  return names[kind];
+}
+
+size_t dm_traj_qcol(const dm_traj *tr, size_t i)
+{
+  return i < tr->n ? 1 + i : DM_TRAJ_NONE;
+}
+
+size_t dm_traj_pcol(const dm_traj *tr, size_t i)
+{
+  if (i >= tr->n || !(tr->flags & DM_TRAJ_WITH_P))
+    return DM_TRAJ_NONE;
+  return 1 + tr->n + i;
+}
+
+size_t dm_traj_vcol(const dm_traj *tr, size_t i)
+{
+  if (i >= tr->n || !(tr->flags & DM_TRAJ_WITH_V))
+    return DM_TRAJ_NONE;
+  return tr->nstate - tr->n + i;
+}
+
+int dm_traj_get(const dm_traj *tr, size_t k, double *t, double *q, double *p,
+                double *v, dm_err *e)
+{
+  size_t i, n = tr->n;
+  if (k >= tr->len)
+    return dm_err_set(e, DM_EINVAL, "sample %zu out of range (%zu samples)",
+                      k, tr->len);
+  if (t != NULL)
+    *t = tr->cols[0].x[k];
+  for (i = 0; i < n; i++) {
+    size_t jp = dm_traj_pcol(tr, i), jv = dm_traj_vcol(tr, i);
+    if (q != NULL)
+      q[i] = tr->cols[1 + i].x[k];
+    if (p != NULL)
+      p[i] = jp != DM_TRAJ_NONE ? tr->cols[jp].x[k] : NAN;
+    if (v != NULL)
+      v[i] = jv != DM_TRAJ_NONE ? tr->cols[jv].x[k] : NAN;
+  }
+  return DM_OK;
+}
+
+int dm_traj_row(const dm_traj *tr, size_t k, double *row, dm_err *e)
+{
+  size_t j;
+  if (k >= tr->len)
+    return dm_err_set(e, DM_EINVAL, "sample %zu out of range (%zu samples)",
+                      k, tr->len);
+  for (j = 0; j < tr->ncols; j++)
+    row[j] = tr->cols[j].x[k];
+  return DM_OK;
+}
+
+/* }==== */
+
+/* {==== extra columns ===================================================== */
+
+static int check_extra_kind(int kind, dm_err *e)
+{
+  if (kind != DM_TRAJ_DIAG && kind != DM_TRAJ_DERIVED && kind != DM_TRAJ_DATA)
+    return dm_err_set(e, DM_EINVAL, "extra column kind must be diag, derived "
+                      "or data (got %d)", kind);
+  return DM_OK;
+}
+
+/* Check `m` new column names; slot[a] receives the index of the extra
+ * column a replaces, or DM_TRAJ_NONE for a new one. */
+static int check_new_names(const dm_traj *tr, size_t m, const char *const *names,
+                           unsigned opts, size_t *slot, dm_err *e)
+{
+  size_t a, b;
+  for (a = 0; a < m; a++) {
+    size_t j;
+    if (!valid_name(names[a]))
+      return bad_name(e, "column", names[a]);
+    for (b = 0; b < a; b++)
+      if (strcmp(names[a], names[b]) == 0)
+        return dm_err_set(e, DM_EINVAL, "column name '%s' is used twice",
+                          names[a]);
+    j = dm_traj_find(tr, names[a]);
+    if (j != DM_TRAJ_NONE && j < tr->nstate)
+      return dm_err_set(e, DM_EINVAL, "column '%s' is a %s column and cannot "
+                        "be replaced", names[a],
+                        dm_traj_kindname(tr->cols[j].kind));
+    if (j != DM_TRAJ_NONE && !(opts & DM_TRAJ_REPLACE))
+      return dm_err_set(e, DM_EINVAL, "column '%s' exists", names[a]);
+    slot[a] = j;
+  }
+  return DM_OK;
+}
+
+/* Install m filled arrays (xs[a] has tr->cap values): replace or append.
+ * Cannot fail: the column array has room (reserved by the caller). */
+static void install(dm_traj *tr, size_t m, char **names, int kind,
+                    double **xs, const size_t *slot)
+{
+  size_t a;
+  for (a = 0; a < m; a++) {
+    column *c;
+    if (slot[a] != DM_TRAJ_NONE) {
+      c = &tr->cols[slot[a]];
+      free(c->name);
+      free(c->x);
+    } else {
+      c = &tr->cols[tr->ncols++];
+    }
+    c->name = names[a];
+    c->kind = kind;
+    c->x = xs[a];
+    names[a] = NULL;
+    xs[a] = NULL;
+  }
+}
+
+/* Allocate what m new columns need: column slots, names, arrays of cap. */
+static int prepare(dm_traj *tr, size_t m, const char *const *names,
+                   char **dn, double **xs, dm_err *e)
+{
+  size_t a;
+  if (tr->ncols + m > tr->colcap) {
+    size_t nc = tr->ncols + m + 8;
+    column *c = realloc(tr->cols, nc * sizeof *c);
+    if (c == NULL)
+      return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory for columns");
+    tr->cols = c;
+    tr->colcap = nc;
+  }
+  for (a = 0; a < m; a++) {
+    dn[a] = dupstr(names[a]);
+    xs[a] = tr->cap > 0 ? malloc(tr->cap * sizeof(double)) : NULL;
+    if (dn[a] == NULL || (tr->cap > 0 && xs[a] == NULL))
+      return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory for column "
+                        "'%s' (%zu samples)", names[a], tr->len);
+  }
+  return DM_OK;
+}
+
+static void release(size_t m, char **dn, double **xs)
+{
+  size_t a;
+  for (a = 0; a < m; a++) {
+    free(dn[a]);
+    free(xs[a]);
+  }
+}
+
+int dm_traj_add_column(dm_traj *tr, const char *name, int kind,
+                       const double *values, unsigned opts, dm_err *e)
+{
+  size_t slot, k;
+  char *dn = NULL;
+  double *x = NULL;
+  int st;
+  if ((st = check_extra_kind(kind, e)) != DM_OK
+      || (st = check_new_names(tr, 1, &name, opts, &slot, e)) != DM_OK)
+    return st;
+  if ((st = prepare(tr, 1, &name, &dn, &x, e)) != DM_OK) {
+    release(1, &dn, &x);
+    return st;
+  }
+  for (k = 0; k < tr->len; k++)
+    x[k] = values != NULL ? values[k] : NAN;
+  install(tr, 1, &dn, kind, &x, &slot);
+  return DM_OK;
+}
+
+int dm_traj_remove_column(dm_traj *tr, const char *name, dm_err *e)
+{
+  size_t j = 0;
+  int st = dm_traj_lookup(tr, name, &j, e);
+  if (st != DM_OK)
+    return st;
+  if (j < tr->nstate)
+    return dm_err_set(e, DM_EINVAL, "column '%s' is a %s column and cannot be "
+                      "removed", name, dm_traj_kindname(tr->cols[j].kind));
+  free(tr->cols[j].name);
+  free(tr->cols[j].x);
+  memmove(&tr->cols[j], &tr->cols[j + 1], (tr->ncols - j - 1) * sizeof *tr->cols);
+  tr->ncols--;
+  return DM_OK;
+}
+
+/* Evaluate fn over every sample into xs (m arrays). */
+static int derive_fill(const dm_traj *tr, size_t m, dm_traj_fn fn, void *ctx,
+                       double *row, double *out, double **xs, dm_err *e)
+{
+  dm_traj_sample s;
+  size_t k, a, n = tr->n;
+  s.n = n;
+  s.row = row;
+  s.q = row + 1;
+  s.p = (tr->flags & DM_TRAJ_WITH_P) ? row + 1 + n : NULL;
+  s.v = (tr->flags & DM_TRAJ_WITH_V) ? row + tr->nstate - n : NULL;
+  s.extra = row + tr->nstate;
+  s.traj = tr;
+  for (k = 0; k < tr->len; k++) {
+    int rc;
+    if (dm_interrupted())
+      return dm_err_set(e, DM_EINTR, "derive: interrupted at sample %zu of %zu",
+                        k, tr->len);
+    dm_traj_row(tr, k, row, NULL);
+    s.k = k;
+    s.t = row[0];
+    rc = fn(ctx, &s, out);
+    if (rc != 0)
+      return dm_err_set(e, DM_ECALLBACK, "derive: callback failed at sample "
+                        "%zu (t = %.17g) with status %d", k, s.t, rc);
+    for (a = 0; a < m; a++)
+      xs[a][k] = out[a];
+  }
+  return DM_OK;
+}
+
+int dm_traj_derive(dm_traj *tr, size_t m, const char *const *names, int kind,
+                   dm_traj_fn fn, void *ctx, unsigned opts, dm_err *e)
+{
+  size_t *slot = NULL;
+  char **dn = NULL;
+  double **xs = NULL, *row = NULL;
+  int st;
+  if (m == 0 || names == NULL || fn == NULL)
+    return dm_err_set(e, DM_EINVAL, "derive: need at least one column name "
+                      "and a function");
+  if ((st = check_extra_kind(kind, e)) != DM_OK)
+    return st;
+  slot = malloc(m * sizeof *slot);
+  dn = calloc(m, sizeof *dn);
+  xs = calloc(m, sizeof *xs);
+  row = malloc((tr->ncols + m) * sizeof *row);
+  if (slot == NULL || dn == NULL || xs == NULL || row == NULL) {
+    st = dm_err_set(e, DM_ENOMEM, "derive: out of memory");
+    goto cleanup;
+  }
+  if ((st = check_new_names(tr, m, names, opts, slot, e)) != DM_OK
+      || (st = prepare(tr, m, names, dn, xs, e)) != DM_OK
+      || (st = derive_fill(tr, m, fn, ctx, row, row + tr->ncols, xs, e)) != DM_OK)
+    goto cleanup;
+  install(tr, m, dn, kind, xs, slot);
+cleanup:
+  if (dn != NULL && xs != NULL)
+    release(m, dn, xs);
+  free(slot);
+  free(dn);
+  free(xs);
+  free(row);
+  return st;
+}
+
+/* }==== */
+
+/* {==== slicing ================================================================ */
+
+static int copy_meta(dm_traj *dst, const dm_traj *src, dm_err *e)
+{
+  size_t i;
+  int st;
+  for (i = 0; i < src->nmeta; i++)
+    if ((st = dm_traj_meta_set(dst, src->mkey[i], src->mval[i], e)) != DM_OK)
+      return st;
+  return DM_OK;
+}
+
+dm_traj *dm_traj_slice(const dm_traj *tr, size_t i, size_t j, size_t stride,
+                       dm_err *e)
+{
+  const char **coords = NULL;
+  dm_traj *s = NULL;
+  size_t a, c, k, count;
+  int st = DM_OK;
+  if (i > j || j > tr->len || stride == 0) {
+    dm_err_set(e, DM_EINVAL, "slice [%zu, %zu) stride %zu of a trajectory "
+               "with %zu samples: need i <= j <= %zu and stride >= 1",
+               i, j, stride, tr->len, tr->len);
+    return NULL;
+  }
+  count = (j - i + stride - 1) / stride;
+  coords = malloc((tr->n + 1) * sizeof *coords);
+  if (coords == NULL) {
+    dm_err_set(e, DM_ENOMEM, "slice: out of memory");
+    return NULL;
+  }
+  for (a = 0; a < tr->n; a++)
+    coords[a] = tr->cols[1 + a].name;
+  s = dm_traj_alloc(tr->n, coords, tr->flags, e);
+  free(coords);
+  if (s == NULL)
+    return NULL;
+  for (c = tr->nstate; c < tr->ncols && st == DM_OK; c++)
+    st = dm_traj_add_column(s, tr->cols[c].name, tr->cols[c].kind, NULL, 0, e);
+  if (st == DM_OK)
+    st = copy_meta(s, tr, e);
+  if (st == DM_OK)
+    st = dm_traj_reserve(s, count, e);
+  if (st != DM_OK) {
+    dm_traj_free(s);
+    return NULL;
+  }
+  for (c = 0; c < tr->ncols; c++) {
+    const double *src = tr->cols[c].x;
+    double *dst = s->cols[c].x;
+    for (k = 0; k < count; k++)
+      dst[k] = src[i + k * stride];
+  }
+  s->len = count;
+  return s;
+}
+
+/* }==== */
+
+/* {==== metadata ============================================================== */
+
+static size_t meta_find(const dm_traj *tr, const char *key)
+{
+  size_t i;
+  for (i = 0; i < tr->nmeta; i++)
+    if (strcmp(tr->mkey[i], key) == 0)
+      return i;
+  return DM_TRAJ_NONE;
+}
+
+static int valid_key(const char *key)
+{
+  const unsigned char *s = (const unsigned char *)key;
+  if (s == NULL || *s == '\0')
+    return 0;
+  for (; *s != '\0'; s++)
+    if (*s < 0x20 || *s == 0x7f || *s == '=')
+      return 0;
+  return 1;
+}
+
+int dm_traj_meta_set(dm_traj *tr, const char *key, const char *value,
+                     dm_err *e)
+{
+  size_t i;
+  char *dk, *dv;
+  if (!valid_key(key))
+    return dm_err_set(e, DM_EINVAL, "invalid metadata key '%.100s' (non-empty,"
+                      " no '=' and no control characters)",
+                      key != NULL ? key : "(null)");
+  i = meta_find(tr, key);
+  if (value == NULL) {                       /* remove */
+    if (i == DM_TRAJ_NONE)
+      return DM_OK;
+    free(tr->mkey[i]);
+    free(tr->mval[i]);
+    memmove(tr->mkey + i, tr->mkey + i + 1, (tr->nmeta - i - 1) * sizeof(char *));
+    memmove(tr->mval + i, tr->mval + i + 1, (tr->nmeta - i - 1) * sizeof(char *));
+    tr->nmeta--;
+    return DM_OK;
+  }
+  if ((dv = dupstr(value)) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
+  if (i != DM_TRAJ_NONE) {
+    free(tr->mval[i]);
+    tr->mval[i] = dv;
+    return DM_OK;
+  }
+  if (tr->nmeta == tr->metacap) {
+    size_t nc = tr->metacap ? 2 * tr->metacap : 8;
+    char **k2 = realloc(tr->mkey, nc * sizeof *k2), **v2;
+    if (k2 != NULL)
+      tr->mkey = k2;
+    v2 = k2 != NULL ? realloc(tr->mval, nc * sizeof *v2) : NULL;
+    if (v2 == NULL) {
+      free(dv);
+      return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
+    }
+    tr->mval = v2;
+    tr->metacap = nc;
+  }
+  if ((dk = dupstr(key)) == NULL) {
+    free(dv);
+    return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
+  }
+  tr->mkey[tr->nmeta] = dk;
+  tr->mval[tr->nmeta] = dv;
+  tr->nmeta++;
+  return DM_OK;
+}
+
+const char *dm_traj_meta_get(const dm_traj *tr, const char *key)
+{
+  size_t i = key != NULL ? meta_find(tr, key) : DM_TRAJ_NONE;
+  return i != DM_TRAJ_NONE ? tr->mval[i] : NULL;
+}
+
+size_t dm_traj_meta_count(const dm_traj *tr) { return tr->nmeta; }
+
+int dm_traj_meta_at(const dm_traj *tr, size_t i, const char **key,
+                    const char **value)
+{
+  if (i >= tr->nmeta)
+    return DM_EINVAL;
+  if (key != NULL)
+    *key = tr->mkey[i];
+  if (value != NULL)
+    *value = tr->mval[i];
+  return DM_OK;
+}
+
+/* }==== */

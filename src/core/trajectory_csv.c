@@ -1,0 +1,653 @@
+/* trajectory_csv.c -- trajectories to and from CSV files (format in
+ * trajectory.h).  Numbers are written with "%.17g" and read with strtod,
+ * both in a private "C" numeric locale selected with uselocale() for this
+ * thread only, so the user's LC_NUMERIC (a decimal comma) never matters. */
+#include <config.h>
+#include "trajectory.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <locale.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "interrupt.h"
+
+#define MAGIC "# dmech trajectory "
+#define FORMAT_VERSION 1
+#define POLL_EVERY 4096
+
+/* {==== the C numeric locale ============================================ */
+
+typedef struct c_numeric {
+  locale_t c, old;
+} c_numeric;
+
+static int c_numeric_enter(c_numeric *cn, dm_err *e)
+{
+  cn->c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+  if (cn->c == (locale_t)0)
+    return dm_err_set(e, DM_ENOMEM, "cannot create the C numeric locale: %s",
+                      strerror(errno));
+  cn->old = uselocale(cn->c);
+  return DM_OK;
+}
+
+static void c_numeric_leave(c_numeric *cn)
+{
+  uselocale(cn->old);
+  freelocale(cn->c);
+}
+
+/* }==== */
+
+/* {==== writing ============================================================ */
+
+/* Metadata values may hold anything but NUL: escape what would break a line. */
+static void put_escaped(FILE *f, const char *s)
+{
+  for (; *s != '\0'; s++) {
+    unsigned char c = (unsigned char)*s;
+    switch (c) {
+    case '\\': fputs("\\\\", f); break;
+    case '\n': fputs("\\n", f); break;
+    case '\r': fputs("\\r", f); break;
+    case '\t': fputs("\\t", f); break;
+    default:
+      if (c < 0x20 || c == 0x7f)
+        fprintf(f, "\\x%02x", c);
+      else
+        fputc(c, f);
+    }
+  }
+}
+
+static void write_head(const dm_traj *tr, FILE *f)
+{
+  size_t i, nc = dm_traj_ncols(tr);
+  fprintf(f, MAGIC "%d\n", FORMAT_VERSION);
+  for (i = 0; i < dm_traj_meta_count(tr); i++) {
+    const char *k, *v;
+    dm_traj_meta_at(tr, i, &k, &v);
+    fprintf(f, "# meta %s=", k);
+    put_escaped(f, v);
+    fputc('\n', f);
+  }
+  fputs("# kinds ", f);
+  for (i = 0; i < nc; i++)
+    fprintf(f, "%s%s", i ? "," : "", dm_traj_kindname(dm_traj_colkind(tr, i)));
+  fputc('\n', f);
+  for (i = 0; i < nc; i++)
+    fprintf(f, "%s%s", i ? "," : "", dm_traj_colname(tr, i));
+  fputc('\n', f);
+}
+
+static int write_body(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
+{
+  size_t k, j, nc = dm_traj_ncols(tr), len = dm_traj_len(tr);
+  for (k = 0; k < len; k++) {
+    if (k % POLL_EVERY == 0 && dm_interrupted())
+      return dm_err_set(e, DM_EINTR, "saving '%.200s': interrupted at sample "
+                        "%zu of %zu", name, k, len);
+    for (j = 0; j < nc; j++)
+      fprintf(f, j ? ",%.17g" : "%.17g", dm_traj_col(tr, j)[k]);
+    if (fputc('\n', f) == EOF)
+      return dm_err_set(e, DM_EIO, "writing '%.200s': %s", name,
+                        strerror(errno));
+  }
+  return DM_OK;
+}
+
+int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
+{
+  c_numeric cn;
+  int st;
+  if (name == NULL)
+    name = "(stream)";
+  if ((st = c_numeric_enter(&cn, e)) != DM_OK)
+    return st;
+  errno = 0;
+  write_head(tr, f);
+  st = write_body(tr, f, name, e);
+  c_numeric_leave(&cn);
+  if (st == DM_OK && (fflush(f) != 0 || ferror(f)))
+    st = dm_err_set(e, DM_EIO, "writing '%.200s': %s", name,
+                    strerror(errno ? errno : EIO));
+  return st;
+}
+
+/* Create "<path>.tmp-<random>" exclusively (mode 0666 minus the umask, like
+ * the final file would get).  O_EXCL makes a guessed name harmless. */
+static int open_temp(const char *path, char **tmp, dm_err *e)
+{
+  static unsigned counter;
+  size_t lp = strlen(path);
+  int attempt;
+  *tmp = malloc(lp + 32);
+  if (*tmp == NULL)
+    return dm_err_set(e, DM_ENOMEM, "saving '%.200s': out of memory", path);
+  for (attempt = 0; attempt < 100; attempt++) {
+    struct timespec ts;
+    uint64_t r;
+    int fd;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    r = ((uint64_t)ts.tv_nsec << 20) ^ (uint64_t)ts.tv_sec
+        ^ ((uint64_t)getpid() << 40) ^ ((uint64_t)(uintptr_t)tmp << 7)
+        ^ (uint64_t)(++counter) * 0x9e3779b97f4a7c15ULL;
+    snprintf(*tmp, lp + 32, "%s.tmp-%016llx", path, (unsigned long long)r);
+    fd = open(*tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0)
+      return fd;
+    if (errno != EEXIST)
+      break;
+  }
+  dm_err_set(e, DM_EIO, "saving '%.200s': cannot create a temporary file "
+             "next to it: %s", path, strerror(errno));
+  free(*tmp);
+  *tmp = NULL;
+  return -1;
+}
+
+/* fsync the directory holding path so the rename itself is durable; a
+ * failure here is not reported (the data are safe, only the name may lag). */
+static void sync_dir(const char *path)
+{
+  const char *slash = strrchr(path, '/');
+  char *dir;
+  int fd;
+  if (slash == NULL) {
+    dir = malloc(2);
+    if (dir != NULL)
+      strcpy(dir, ".");
+  } else {
+    size_t k = slash == path ? 1 : (size_t)(slash - path);
+    dir = malloc(k + 1);
+    if (dir != NULL) {
+      memcpy(dir, path, k);
+      dir[k] = '\0';
+    }
+  }
+  if (dir == NULL)
+    return;
+  fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0) {
+    fsync(fd);
+    close(fd);
+  }
+  free(dir);
+}
+
+int dm_traj_save(const dm_traj *tr, const char *path, dm_err *e)
+{
+  char *tmp = NULL;
+  FILE *f;
+  int fd, st;
+  if (path == NULL || path[0] == '\0')
+    return dm_err_set(e, DM_EINVAL, "save: empty file name");
+  fd = open_temp(path, &tmp, e);
+  if (fd < 0)
+    return e != NULL ? e->status : DM_EIO;
+  f = fdopen(fd, "w");
+  if (f == NULL) {
+    st = dm_err_set(e, DM_EIO, "saving '%.200s': %s", path, strerror(errno));
+    close(fd);
+    goto fail;
+  }
+  st = dm_traj_write(tr, f, path, e);
+  if (st == DM_OK && fsync(fileno(f)) != 0)
+    st = dm_err_set(e, DM_EIO, "saving '%.200s': fsync: %s", path,
+                    strerror(errno));
+  if (fclose(f) != 0 && st == DM_OK)
+    st = dm_err_set(e, DM_EIO, "saving '%.200s': %s", path, strerror(errno));
+  if (st != DM_OK)
+    goto fail;
+  if (rename(tmp, path) != 0) {
+    st = dm_err_set(e, DM_EIO, "saving '%.200s': cannot rename the temporary "
+                    "file: %s", path, strerror(errno));
+    goto fail;
+  }
+  free(tmp);
+  sync_dir(path);
+  return DM_OK;
+fail:
+  unlink(tmp);
+  free(tmp);
+  return st;
+}
+
+/* }==== */
+
+/* {==== reading ============================================================ */
+
+typedef struct reader {
+  const char *path;
+  FILE *f;
+  char *line;           /* current line, newline stripped */
+  size_t cap;
+  size_t lineno;
+  dm_err *e;
+} reader;
+
+/* Next line into r->line: 1, 0 at end of file, -1 on error (e set). */
+static int next_line(reader *r)
+{
+  ssize_t k;
+  errno = 0;
+  k = getline(&r->line, &r->cap, r->f);
+  if (k < 0) {
+    if (ferror(r->f)) {
+      dm_err_set(r->e, DM_EIO, "reading '%.200s': %s", r->path,
+                 strerror(errno ? errno : EIO));
+      return -1;
+    }
+    return 0;
+  }
+  r->lineno++;
+  if ((size_t)k != strlen(r->line)) {
+    dm_err_set(r->e, DM_EINVAL, "%.200s:%zu: line contains a NUL byte",
+               r->path, r->lineno);
+    return -1;
+  }
+  if (k > 0 && r->line[k - 1] == '\n')
+    r->line[--k] = '\0';
+  if (k > 0 && r->line[k - 1] == '\r')
+    r->line[--k] = '\0';
+  return 1;
+}
+
+static int fail_at(reader *r, const char *fmt, const char *a, const char *b)
+{
+  char msg[DM_ERRMSG_MAX];
+  snprintf(msg, sizeof msg, fmt, a, b);
+  return dm_err_set(r->e, DM_EINVAL, "%.200s:%zu: %s", r->path, r->lineno, msg);
+}
+
+/* Prefix a message some trajectory call left in e with "path:line: ". */
+static int relocate(reader *r, int st)
+{
+  char msg[DM_ERRMSG_MAX];
+  if (r->e == NULL)
+    return st;
+  snprintf(msg, sizeof msg, "%s", r->e->msg);
+  return dm_err_set(r->e, st, "%.200s:%zu: %s", r->path, r->lineno, msg);
+}
+
+/* Number of comma-separated fields in s. */
+static size_t count_fields(const char *s)
+{
+  size_t count = 1;
+  for (; *s != '\0'; s++)
+    count += *s == ',';
+  return count;
+}
+
+/* Split s in place at commas into fields[count_fields(s)]. */
+static void split(char *s, char **fields)
+{
+  size_t count = 0;
+  for (;;) {
+    char *c = strchr(s, ',');
+    fields[count++] = s;
+    if (c == NULL)
+      return;
+    *c = '\0';
+    s = c + 1;
+  }
+}
+
+static int unescape(reader *r, char *s)
+{
+  char *w = s;
+  for (; *s != '\0'; s++) {
+    if (*s != '\\') {
+      *w++ = *s;
+      continue;
+    }
+    s++;
+    switch (*s) {
+    case '\\': *w++ = '\\'; break;
+    case 'n': *w++ = '\n'; break;
+    case 'r': *w++ = '\r'; break;
+    case 't': *w++ = '\t'; break;
+    case 'x': {
+      char hex[3] = {0, 0, 0}, *end;
+      long c;
+      if (s[1] != '\0')
+        memcpy(hex, s + 1, 2);
+      c = strtol(hex, &end, 16);
+      if (end != hex + 2 || c == 0)
+        return fail_at(r, "bad escape '\\x%.2s' in metadata value%s", hex, "");
+      *w++ = (char)c;
+      s += 2;
+      break;
+    }
+    default:
+      return fail_at(r, "bad escape '\\%.1s' in metadata value (expected "
+                     "\\\\, \\n, \\r, \\t or \\xHH)%s", s, "");
+    }
+  }
+  *w = '\0';
+  return DM_OK;
+}
+
+static int kind_of(const char *s)
+{
+  int k;
+  for (k = DM_TRAJ_T; k <= DM_TRAJ_DATA; k++)
+    if (strcmp(s, dm_traj_kindname(k)) == 0)
+      return k;
+  return -1;
+}
+
+/* Everything seen before the header line. */
+typedef struct preamble {
+  int magic;               /* "# dmech trajectory 1" seen */
+  char *kinds;             /* copy of the kinds list, or NULL */
+  size_t kinds_line;
+  char **mkey, **mval;     /* metadata in file order */
+  size_t nmeta;
+} preamble;
+
+static void preamble_free(preamble *pr)
+{
+  size_t i;
+  for (i = 0; i < pr->nmeta; i++) {
+    free(pr->mkey[i]);
+    free(pr->mval[i]);
+  }
+  free(pr->mkey);
+  free(pr->mval);
+  free(pr->kinds);
+}
+
+static int read_meta(reader *r, preamble *pr, const char *text)
+{
+  const char *eq = strchr(text, '=');
+  char *k, *v, **nk, **nv;
+  size_t i;
+  int st;
+  if (eq == NULL || eq == text)
+    return fail_at(r, "expected '# meta key=value', got '# meta %.200s'%s",
+                   text, "");
+  k = strndup(text, (size_t)(eq - text));
+  v = strdup(eq + 1);
+  nk = realloc(pr->mkey, (pr->nmeta + 1) * sizeof *nk);
+  if (nk != NULL)
+    pr->mkey = nk;
+  nv = nk != NULL ? realloc(pr->mval, (pr->nmeta + 1) * sizeof *nv) : NULL;
+  if (nv != NULL)
+    pr->mval = nv;
+  if (k == NULL || v == NULL || nv == NULL) {
+    free(k);
+    free(v);
+    return dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
+  }
+  for (i = 0; i < pr->nmeta; i++)
+    if (strcmp(pr->mkey[i], k) == 0) {
+      st = fail_at(r, "duplicate metadata key '%.200s'%s", k, "");
+      free(k);
+      free(v);
+      return st;
+    }
+  pr->mkey[pr->nmeta] = k;
+  pr->mval[pr->nmeta] = v;
+  pr->nmeta++;
+  return unescape(r, v);
+}
+
+/* One '#' line before the header. */
+static int read_comment(reader *r, preamble *pr)
+{
+  const char *s = r->line;
+  if (strncmp(s, MAGIC, strlen(MAGIC)) == 0) {
+    const char *ver = s + strlen(MAGIC);
+    if (strcmp(ver, "1") != 0)
+      return fail_at(r, "unsupported trajectory format version '%.50s' (this "
+                     "dmech reads version 1)%s", ver, "");
+    pr->magic = 1;
+    return DM_OK;
+  }
+  if (strncmp(s, "# meta ", 7) == 0)
+    return read_meta(r, pr, s + 7);
+  if (strncmp(s, "# kinds ", 8) == 0) {
+    if (pr->kinds != NULL) {
+      char a[32];
+      snprintf(a, sizeof a, "%zu", pr->kinds_line);
+      return fail_at(r, "second '# kinds' line (the first is on line %s)%s",
+                     a, "");
+    }
+    pr->kinds = strdup(s + 8);
+    pr->kinds_line = r->lineno;
+    if (pr->kinds == NULL)
+      return dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory",
+                        r->path);
+  }
+  return DM_OK;                  /* any other comment is ignored */
+}
+
+/* Check the kinds against the header names: t, n q, [n p], [n v], extras. */
+static int layout(reader *r, char **names, char **kinds, size_t nc,
+                  size_t *n, unsigned *flags, int *kind)
+{
+  size_t j, i, q0;
+  char want[DM_TRAJ_NAME_MAX + 8];
+  for (i = 0; i < nc; i++) {
+    kind[i] = kinds != NULL ? kind_of(kinds[i]) : (i == 0 ? DM_TRAJ_T : DM_TRAJ_DATA);
+    if (kind[i] < 0)
+      return fail_at(r, "unknown column kind '%.50s' in '# kinds' (expected t, "
+                     "q, p, v, diag, derived or data)%s", kinds[i], "");
+  }
+  for (i = 1; i < nc; i++)
+    for (j = 0; j < i; j++)
+      if (strcmp(names[i], names[j]) == 0)
+        return fail_at(r, "column '%.100s' appears twice in the header%s",
+                       names[i], "");
+  j = 1;
+  if (kind[0] != DM_TRAJ_T || strcmp(names[0], "t") != 0)
+    return fail_at(r, "the first column must be 't' of kind t (got '%.100s' "
+                   "of kind %s)", names[0], dm_traj_kindname(kind[0]));
+  for (q0 = j; j < nc && kind[j] == DM_TRAJ_Q; j++)
+    ;
+  *n = j - q0;
+  *flags = 0;
+  if (j < nc && kind[j] == DM_TRAJ_P) {
+    for (i = 0; i < *n; i++, j++) {
+      snprintf(want, sizeof want, "p_%s", names[q0 + i]);
+      if (j >= nc || kind[j] != DM_TRAJ_P || strcmp(names[j], want) != 0)
+        return fail_at(r, "expected momentum column '%.140s' of kind p after "
+                       "the q columns%s", want, "");
+    }
+    *flags |= DM_TRAJ_WITH_P;
+  }
+  if (j < nc && kind[j] == DM_TRAJ_V) {
+    for (i = 0; i < *n; i++, j++) {
+      snprintf(want, sizeof want, "v_%s", names[q0 + i]);
+      if (j >= nc || kind[j] != DM_TRAJ_V || strcmp(names[j], want) != 0)
+        return fail_at(r, "expected velocity column '%.140s' of kind v after "
+                       "the q and p columns%s", want, "");
+    }
+    *flags |= DM_TRAJ_WITH_V;
+  }
+  for (; j < nc; j++)
+    if (kind[j] < DM_TRAJ_DIAG)
+      return fail_at(r, "column '%.100s' of kind %s is out of place (order: "
+                     "t, q..., p..., v..., then diag/derived/data)",
+                     names[j], dm_traj_kindname(kind[j]));
+  return DM_OK;
+}
+
+/* Build the empty trajectory described by the header line and preamble. */
+static dm_traj *make_traj(reader *r, preamble *pr, size_t *ncols)
+{
+  size_t nc = count_fields(r->line), nk = 0, n = 0, i;
+  char **names = malloc(nc * sizeof *names), **kinds = NULL;
+  int *kind = malloc(nc * sizeof *kind);
+  unsigned flags = 0;
+  dm_traj *tr = NULL;
+  int st;
+  if (names == NULL || kind == NULL) {
+    dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
+    goto done;
+  }
+  split(r->line, names);
+  if (pr->kinds != NULL) {
+    nk = count_fields(pr->kinds);
+    if ((kinds = malloc(nk * sizeof *kinds)) == NULL) {
+      dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
+      goto done;
+    }
+    split(pr->kinds, kinds);
+    if (nk != nc) {
+      char a[32], b[32];
+      snprintf(a, sizeof a, "%zu", nc);
+      snprintf(b, sizeof b, "%zu", nk);
+      fail_at(r, "the header names %s columns but '# kinds' lists %s", a, b);
+      goto done;
+    }
+  } else if (pr->magic) {
+    fail_at(r, "expected a '# kinds' line before the header%s%s", "", "");
+    goto done;
+  }
+  if (layout(r, names, kinds, nc, &n, &flags, kind) != DM_OK)
+    goto done;
+  tr = dm_traj_alloc(n, (const char *const *)names + 1, flags, r->e);
+  for (i = 1 + n * (1 + !!(flags & DM_TRAJ_WITH_P) + !!(flags & DM_TRAJ_WITH_V));
+       tr != NULL && i < nc; i++)
+    if ((st = dm_traj_add_column(tr, names[i], kind[i], NULL, 0, r->e)) != DM_OK) {
+      dm_traj_free(tr);
+      tr = NULL;
+    }
+  for (i = 0; tr != NULL && i < pr->nmeta; i++)
+    if ((st = dm_traj_meta_set(tr, pr->mkey[i], pr->mval[i], r->e)) != DM_OK) {
+      dm_traj_free(tr);
+      tr = NULL;
+    }
+  if (tr == NULL && (r->e == NULL || r->e->status != DM_ENOMEM))
+    relocate(r, DM_EINVAL);
+  *ncols = nc;
+done:
+  free(names);
+  free(kinds);
+  free(kind);
+  return tr;
+}
+
+/* Parse one data line into row[nc]. */
+static int parse_row(reader *r, const dm_traj *tr, size_t nc, double *row)
+{
+  char *s = r->line, *end;
+  size_t j;
+  if (*s == '\0') {
+    char a[32];
+    snprintf(a, sizeof a, "%zu", nc);
+    return fail_at(r, "empty line (expected %s comma-separated numbers)%s", a, "");
+  }
+  for (j = 0; j < nc; j++) {
+    char *field = s;
+    row[j] = strtod(s, &end);
+    while (*end == ' ' || *end == '\t')
+      end++;
+    if (end == s || (*end != ',' && *end != '\0')) {
+      char *c = strchr(field, ',');
+      char msg[DM_ERRMSG_MAX];
+      if (c != NULL)
+        *c = '\0';
+      snprintf(msg, sizeof msg, "field %zu (column '%s'): '%.60s' is not a number",
+               j + 1, dm_traj_colname(tr, j), field);
+      return fail_at(r, "%s%s", msg, "");
+    }
+    if (*end == '\0' && j + 1 < nc) {
+      char a[64], b[32];
+      snprintf(a, sizeof a, "%zu", nc);
+      snprintf(b, sizeof b, "%zu", j + 1);
+      return fail_at(r, "expected %s comma-separated numbers, got %s", a, b);
+    }
+    s = end + 1;
+    if (*end == '\0')
+      break;
+  }
+  if (*end == ',') {
+    char a[64], b[32];
+    snprintf(a, sizeof a, "%zu", nc);
+    snprintf(b, sizeof b, "%zu", nc + count_fields(s));
+    return fail_at(r, "expected %s comma-separated numbers, got %s", a, b);
+  }
+  return DM_OK;
+}
+
+static int read_rows(reader *r, dm_traj *tr, size_t nc)
+{
+  double *row = malloc(nc * sizeof *row);
+  size_t n = dm_traj_ncoords(tr), j;
+  const double *q = row + 1, *p = NULL, *v = NULL;
+  int got, st = DM_OK;
+  if (row == NULL)
+    return dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
+  j = 1 + n;
+  if (dm_traj_flags(tr) & DM_TRAJ_WITH_P) {
+    p = row + j;
+    j += n;
+  }
+  if (dm_traj_flags(tr) & DM_TRAJ_WITH_V) {
+    v = row + j;
+    j += n;
+  }
+  while (st == DM_OK && (got = next_line(r)) > 0) {
+    if (r->lineno % POLL_EVERY == 0 && dm_interrupted())
+      st = dm_err_set(r->e, DM_EINTR, "reading '%.200s': interrupted at line "
+                      "%zu", r->path, r->lineno);
+    else if ((st = parse_row(r, tr, nc, row)) == DM_OK)
+      st = dm_traj_append(tr, row[0], q, p, v, row + j, r->e);
+  }
+  if (st == DM_OK && got < 0)
+    st = r->e != NULL ? r->e->status : DM_EIO;
+  free(row);
+  return st;
+}
+
+dm_traj *dm_traj_load(const char *path, dm_err *e)
+{
+  reader r = {0};
+  preamble pr = {0};
+  dm_traj *tr = NULL;
+  c_numeric cn;
+  size_t nc = 0;
+  int got, st = DM_OK;
+  r.path = path != NULL ? path : "";
+  r.e = e;
+  r.f = fopen(r.path, "re");
+  if (r.f == NULL) {
+    dm_err_set(e, DM_EIO, "cannot open '%.200s': %s", r.path, strerror(errno));
+    return NULL;
+  }
+  while ((got = next_line(&r)) > 0 && r.line[0] == '#')
+    if ((st = read_comment(&r, &pr)) != DM_OK)
+      break;
+  if (st == DM_OK && got == 0)
+    dm_err_set(e, DM_EINVAL, "%.200s:%zu: no header line (expected 't,...' "
+               "naming the columns)", r.path, r.lineno);
+  else if (st == DM_OK && got > 0 && r.line[0] == '\0')
+    fail_at(&r, "empty line where the header was expected ('t,...')%s%s", "", "");
+  else if (st == DM_OK && got > 0)
+    tr = make_traj(&r, &pr, &nc);
+  if (tr != NULL && c_numeric_enter(&cn, e) == DM_OK) {
+    st = read_rows(&r, tr, nc);
+    c_numeric_leave(&cn);
+  } else if (tr != NULL) {
+    st = e != NULL ? e->status : DM_ENOMEM;
+  }
+  if (st != DM_OK) {
+    dm_traj_free(tr);
+    tr = NULL;
+  }
+  preamble_free(&pr);
+  free(r.line);
+  fclose(r.f);
+  return tr;
+}
+
+/* }==== */
