@@ -62,9 +62,9 @@ function M.help(x)
     return
   end
   local name = x
-  if docs[name] then return show(docs[name]) end
-  if docs["dm." .. name] then return show(docs["dm." .. name]) end
-  if show_group(docs, name .. ":") > 0 then return end
+  local rec = docs[name] or docs["dm." .. name]
+  if rec then show(rec) end
+  if show_group(docs, name .. ":") > 0 or rec then return end
   if show_group(docs, name .. ".") > 0 then return end
   -- a bare method or function name: every entry ending in it
   local hits = sorted_names(docs, function(n) return n:match("[:.]" .. name:gsub("%p", "%%%0") .. "$") end)

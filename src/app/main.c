@@ -90,6 +90,7 @@ int dm_docall(lua_State *L, int narg, int nres)
 
 static void l_message(const char *pname, const char *msg)
 {
+  fflush(stdout);           /* keep stdout and stderr in order in pipes */
   if (pname)
     fprintf(stderr, "%s: ", pname);
   fprintf(stderr, "%s\n", msg);

@@ -213,6 +213,7 @@ static void history_open(void)
     return;
   }
   /* Timestamps delimit entries, so a multi-line chunk reads back as one. */
+  history_comment_char = '#';
   history_write_timestamps = 1;
   history_multiline_entries = 1;
   fd = open(history_path, O_WRONLY | O_CREAT | O_APPEND, 0600);
@@ -319,15 +320,27 @@ static int loadline(lua_State *L, int *expr, int *quiet)
     lua_pushfstring(L, "%s", line + 1);
     lua_replace(L, 1);
   }
+  line = lua_tolstring(L, 1, &len);
+  *quiet = ends_with_semicolon(line, len);
   *expr = 1;
+  if (*quiet) {           /* "return x;;" is not Lua: try without the ';' */
+    size_t l = len;
+    while (line[l - 1] != ';')
+      l--;
+    lua_pushlstring(L, line, l - 1);
+  } else {
+    lua_pushvalue(L, 1);
+  }
   if ((status = addreturn(L)) != LUA_OK) {
     *expr = 0;
+    lua_settop(L, 1);
     status = multiline(L);
     if (status == -1)
       return -2;
+  } else {
+    lua_remove(L, -2);    /* the copy of the line */
   }
   line = lua_tolstring(L, 1, &len);
-  *quiet = ends_with_semicolon(line, len);
 #ifdef HAVE_READLINE
   if (use_readline)
     history_add(line);

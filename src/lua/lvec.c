@@ -67,7 +67,7 @@ static gsl_vector *vec_fromtable(lua_State *L, int arg)
     x = lua_tonumberx(L, -1, &isnum);
     if (!isnum) {
       const char *msg = lua_pushfstring(L, "table of numbers expected, got %s at index %d",
-                                        luaL_typename(L, -2), (int)i + 1);
+                                        luaL_typename(L, -1), (int)i + 1);
       luaL_argerror(L, arg, msg);
     }
     v->data[i] = x;
@@ -471,7 +471,7 @@ static const dm_reg vec_funcs[] = {
   {"vec", l_vec, "dm.vec(n | {x1, ...} | v | x1, x2, ...) -> vec",
    "A vector of n zeros, or of the given numbers (a copy when given a vec)."},
   {"linspace", l_linspace, "dm.linspace(a, b, n) -> vec",
-   "n equally spaced numbers from a to b inclusive."},
+   "Vector of n equally spaced numbers from a to b, both included."},
   {NULL, NULL, NULL, NULL}
 };
 

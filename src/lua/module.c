@@ -52,6 +52,12 @@ static void setpath(lua_State *L)
   lua_pop(L, 1);
 }
 
+static int return_upvalue(lua_State *L)
+{
+  lua_pushvalue(L, lua_upvalueindex(1));
+  return 1;
+}
+
 int luaopen_dmech(lua_State *L)
 {
   dm_gsl_init();
@@ -66,5 +72,20 @@ int luaopen_dmech(lua_State *L)
   lua_getglobal(L, "require");
   lua_pushliteral(L, "dmech.init");
   lua_call(L, 1, 1);
+  /* From now on the module is known under one name only ("dmech", set by
+   * require), so tracebacks name functions dmech.vec, not dmech.init.vec;
+   * later requires of "dmech.core" get the same table through preload. */
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "loaded");
+  lua_pushnil(L);
+  lua_setfield(L, -2, "dmech.core");
+  lua_pushnil(L);
+  lua_setfield(L, -2, "dmech.init");
+  lua_pop(L, 1);
+  lua_getfield(L, -1, "preload");
+  lua_pushvalue(L, -3);
+  lua_pushcclosure(L, return_upvalue, 1);
+  lua_setfield(L, -2, "dmech.core");
+  lua_pop(L, 2);
   return 1;
 }

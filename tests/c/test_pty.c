@@ -1,0 +1,249 @@
+/* test_pty.c -- drive the interactive dmech through a pseudo-terminal:
+ * tab completion (dm.v<TAB>, v:<TAB>), Ctrl-C at the prompt, Ctrl-C inside
+ * `while true do end` keeping variables, a second Ctrl-C quitting, and
+ * history (one entry per multi-line chunk) persisted across two sessions. */
+#include <config.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "tap.h"
+
+#define BUFSZ 65536
+
+typedef struct session {
+  pid_t pid;
+  int fd;
+  char buf[BUFSZ];
+  size_t len;
+} session;
+
+static const char *dmech, *tmp;
+
+static int start(session *s, const char *statedir)
+{
+  struct winsize ws = {24, 100, 0, 0};
+  s->len = 0;
+  s->buf[0] = '\0';
+  s->pid = forkpty(&s->fd, NULL, NULL, &ws);
+  if (s->pid < 0)
+    return -1;
+  if (s->pid == 0) {
+    setenv("TERM", "dumb", 1);
+    setenv("INPUTRC", "/dev/null", 1);
+    setenv("HOME", tmp, 1);
+    setenv("XDG_STATE_HOME", statedir, 1);
+    execl(dmech, dmech, (char *)NULL);
+    _exit(127);
+  }
+  return 0;
+}
+
+/* Read until `want` appears after position `from` (or timeout); 1 if seen. */
+static int expect_from(session *s, size_t from, const char *want, double timeout)
+{
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  for (;;) {
+    struct pollfd p = {s->fd, POLLIN, 0};
+    double el;
+    if (s->len > from && strstr(s->buf + from, want) != NULL)
+      return 1;
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    el = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    if (el > timeout)
+      return 0;
+    if (poll(&p, 1, 50) > 0) {
+      ssize_t r = read(s->fd, s->buf + s->len, BUFSZ - 1 - s->len);
+      if (r <= 0)
+        return strstr(s->buf + from, want) != NULL;
+      s->len += (size_t)r;
+      s->buf[s->len] = '\0';
+      /* NULs from the terminal would cut strstr short */
+      for (size_t i = s->len - (size_t)r; i < s->len; i++)
+        if (s->buf[i] == '\0')
+          s->buf[i] = ' ';
+    }
+  }
+}
+
+static void send(session *s, const char *text)
+{
+  size_t n = strlen(text);
+  if (write(s->fd, text, n) != (ssize_t)n)
+    perror("write");
+}
+
+static int finish(session *s, int *status)
+{
+  int i;
+  for (i = 0; i < 100; i++) {
+    pid_t r = waitpid(s->pid, status, WNOHANG);
+    if (r == s->pid) {
+      close(s->fd);
+      tap_diag("child %d ended: %s %d", (int)s->pid,
+               WIFEXITED(*status) ? "exit status" : "signal",
+               WIFEXITED(*status) ? WEXITSTATUS(*status) : WTERMSIG(*status));
+      return 1;
+    }
+    expect_from(s, s->len, "\x01\x02never", 0.05);   /* drain */
+    usleep(50000);
+  }
+  kill(s->pid, SIGKILL);
+  waitpid(s->pid, status, 0);
+  close(s->fd);
+  return 0;
+}
+
+static void show_tail(const session *s)
+{
+  size_t from = s->len > 300 ? s->len - 300 : 0;
+  const char *p;
+  printf("#   terminal tail: ");
+  for (p = s->buf + from; *p; p++)
+    putchar(*p == '\n' ? '|' : (*p == '\r' ? ' ' : *p));
+  printf("\n");
+}
+
+#define EXPECT(s, from, want, name)                                      \
+  do {                                                                   \
+    if (!tap_ok(expect_from(s, from, want, 10.0), "%s", name))           \
+      show_tail(s);                                                      \
+  } while (0)
+
+int main(void)
+{
+  session s;
+  char state[1024], hist[1100], line[4096];
+  size_t mark;
+  int status;
+  FILE *f;
+
+  dmech = getenv("DMECH");
+  tmp = getenv("DMECH_TESTTMP");
+  if (dmech == NULL || tmp == NULL) {
+    printf("1..0 # SKIP DMECH and DMECH_TESTTMP must be set (run through make check)\n");
+    return 0;
+  }
+  snprintf(state, sizeof state, "%s/pty-state", tmp);
+  snprintf(hist, sizeof hist, "%s/dmech/history", state);
+  unlink(hist);
+
+  /* ---- session 1 ---- */
+  if (start(&s, state) != 0) {
+    printf("1..0 # SKIP forkpty failed: %s\n", strerror(errno));
+    return 0;
+  }
+  EXPECT(&s, 0, "dm> ", "prompt appears");
+
+  mark = s.len;
+  send(&s, "dm.v\t");
+  EXPECT(&s, mark, "dm.vec", "dm.v<TAB> completes to dm.vec");
+  mark = s.len;
+  send(&s, "\x03");                           /* Ctrl-C clears the line */
+  EXPECT(&s, mark, "dm> ", "Ctrl-C at the prompt gives a fresh prompt");
+  mark = s.len;
+  send(&s, "6 * 7\r");
+  EXPECT(&s, mark, "42", "the cleared line is gone (6 * 7 -> 42)");
+  tap_ok(strstr(s.buf + mark, "dm.vec6") == NULL && strstr(s.buf + mark, "error") == NULL,
+         "no leftover text from the cleared line");
+
+  mark = s.len;
+  send(&s, "v = dm.vec{3, 4}\r");
+  EXPECT(&s, mark, "vec{3, 4}", "assignment echoes the value");
+  mark = s.len;
+  send(&s, "v:no\t");
+  EXPECT(&s, mark, "v:norm", "v:no<TAB> completes a method of a userdata");
+  send(&s, "()\r");
+  EXPECT(&s, mark, "5.0", "completed method runs");
+  mark = s.len;
+  send(&s, "v:\t\t");
+  EXPECT(&s, mark, "v:totable", "v:<TAB><TAB> lists the methods");
+  send(&s, "\x03");
+  mark = s.len;
+  send(&s, "string.for\t");
+  EXPECT(&s, mark, "string.format", "completion through nested tables");
+  send(&s, "\x03");
+
+  mark = s.len;
+  send(&s, "x = 2.385; while true do end\r");
+  usleep(300000);
+  send(&s, "\x03");
+  EXPECT(&s, mark, "interrupted!", "Ctrl-C stops a running loop");
+  mark = s.len;
+  send(&s, "x * 2\r");
+  EXPECT(&s, mark, "4.77", "variables intact after the interrupt");
+
+  mark = s.len;
+  send(&s, "for i = 1, 2 do\r");
+  send(&s, "io.write('k', i, ' ')\r");
+  send(&s, "end\r");
+  EXPECT(&s, mark, "k1 k2", "multi-line chunk runs");
+  mark = s.len;
+  send(&s, "print('again' .. 6 * 7)\r");
+  EXPECT(&s, mark, "again42", "last entry runs");
+  EXPECT(&s, mark, "dm> ", "prompt back");   /* ^D only counts at a prompt */
+  send(&s, "\x04");                            /* Ctrl-D: end of input */
+  tap_ok(finish(&s, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0,
+         "Ctrl-D leaves with status 0");
+
+  /* the history file: one entry per chunk */
+  f = fopen(hist, "r");
+  tap_ok(f != NULL, "history file written at %s", hist);
+  if (f != NULL) {
+    int entries = 0, saw_multi = 0;
+    struct stat st;
+    char prev[4096] = "";
+    while (fgets(line, sizeof line, f) != NULL) {
+      if (line[0] == '#' && line[1] >= '0' && line[1] <= '9')
+        entries++;
+      if (strstr(prev, "for i = 1, 2 do") && strstr(line, "io.write"))
+        saw_multi = 1;
+      snprintf(prev, sizeof prev, "%s", line);
+    }
+    fclose(f);
+    tap_ok(saw_multi, "multi-line chunk stored as consecutive lines of one entry");
+    tap_ok(entries >= 6, "timestamps delimit %d entries", entries);
+    tap_ok(stat(hist, &st) == 0 && (st.st_mode & 077) == 0, "history file is private (0600)");
+  } else {
+    tap_ok(0, "multi-line chunk stored");
+    tap_ok(0, "entries");
+    tap_ok(0, "history file private");
+  }
+
+  /* ---- session 2: history comes back ---- */
+  if (start(&s, state) != 0)
+    return tap_done();
+  EXPECT(&s, 0, "dm> ", "second session prompt");
+  mark = s.len;
+  send(&s, "\x10\r");                          /* Ctrl-P: previous entry */
+  EXPECT(&s, mark, "again42", "previous session's last entry recalled");
+  mark = s.len;
+  send(&s, "\x10\x10\x10\r");                   /* back over the multi-line chunk */
+  EXPECT(&s, mark, "k1 k2", "a multi-line chunk is recalled as one entry");
+  send(&s, "\x04");
+  finish(&s, &status);
+
+  /* ---- a second Ctrl-C during the same run quits ---- */
+  if (start(&s, state) != 0)
+    return tap_done();
+  EXPECT(&s, 0, "dm> ", "third session prompt");
+  send(&s, "while true do pcall(function() while true do end end) end\r");
+  usleep(300000);
+  send(&s, "\x03");
+  usleep(300000);
+  send(&s, "\x03");
+  tap_ok(finish(&s, &status) && WIFSIGNALED(status) && WTERMSIG(status) == SIGINT,
+         "a second Ctrl-C during the same run quits");
+  return tap_done();
+}
