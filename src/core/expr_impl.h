@@ -1,0 +1,73 @@
+/* expr_impl.h -- internals of the expression context shared by expr.c,
+ * expr_diff.c, expr_print.c and tape.c.  Not a public header. */
+#ifndef DM_EXPR_IMPL_H
+#define DM_EXPR_IMPL_H
+
+#include "expr.h"
+
+/* One node: 16 bytes.  Leaves: CONST (a = index into cval), SYM / PARAM
+ * (a = name index).  POWI: a = base, b = exponent.  Others: operands a, b, c
+ * (unused ones are -1). */
+typedef struct dm_node {
+  uint8_t op;
+  uint8_t flags;            /* DM_NF_* */
+  uint16_t pad;
+  int32_t a, b, c;
+} dm_node;
+
+enum { DM_NF_SYM = 1u, DM_NF_PARAM = 2u };
+
+typedef struct dm_memo_ent {
+  int32_t node, var, res;
+} dm_memo_ent;
+
+struct dm_expr_ctx {
+  dm_node *node;
+  size_t n, cap;
+  double *cval;             /* constant values */
+  size_t ncval, capcval;
+  int32_t *htab;            /* cons table: node handles, -1 empty */
+  size_t hcap;              /* power of two */
+  char **names;             /* symbol / parameter names */
+  size_t nnames, capnames;
+  int32_t *ntab;            /* name table: name indices, -1 empty */
+  size_t ntcap;
+  dm_memo_ent *memo;        /* derivative memo (node, var) -> result */
+  size_t nmemo, memocap;
+  /* per-node scratch for traversals: aux[i] valid iff stamp[i] == epoch */
+  uint32_t *stamp;
+  int32_t *aux;
+  uint32_t epoch;
+  size_t scap;
+  int32_t *stack, *list;    /* traversal buffers */
+  size_t stackcap, listcap;
+  dm_err err;
+};
+
+/* Record an error in the context (first one wins); returns DM_EXPR_NONE. */
+dm_expr dm_expr__fail(dm_expr_ctx *ctx, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+  __attribute__((format(printf, 3, 4)))
+#endif
+  ;
+
+static inline int dm_expr__valid(const dm_expr_ctx *ctx, dm_expr e)
+{
+  return e >= 0 && (size_t)e < ctx->n;
+}
+
+static inline int dm_expr__arity(int op)
+{
+  if (op <= DM_EXPR_PARAM) return 0;
+  if (op <= DM_EXPR_NE) return 2;
+  if (op == DM_EXPR_SELECT) return 3;
+  return 1;                 /* POWI counts as unary: exponent is data */
+}
+
+/* Collect the nodes reachable from roots[0..n-1] in ascending (topological)
+ * order into ctx->list; returns their number or -1 (out of memory).  Starts
+ * a new epoch: stamp[i] == epoch marks exactly the collected nodes, and
+ * aux[] of those nodes is free for the caller. */
+long dm_expr__collect(dm_expr_ctx *ctx, size_t n, const dm_expr *roots);
+
+#endif
