@@ -117,6 +117,19 @@ gsl_matrix *dm_checkmatrix(lua_State *L, int arg, size_t rows, size_t cols);
 void dm_open_doc(lua_State *L);      /* dm.docs, dm.doc */
 void dm_open_linalg(lua_State *L);
 void dm_open_mat(lua_State *L);   /* part of dm_open_linalg */
+/* Trajectories (l_traj.c): the Trajectory class, dm.trajectory, dm.load_trajectory.
+ * Bindings producing one (integrator runs): `dm_traj **slot = dm_newtraj(L);` pushes
+ * an empty Trajectory that owns whatever *slot holds (set *slot = dm_traj_alloc(...)),
+ * or dm_pushtraj() allocates too (raises on failure).  Fill with dm_traj_sink; add
+ * diagnostics with dm_traj_add_column(tr, DM_TRAJ_ENERGY or "momentum_<q>",
+ * DM_TRAJ_DIAG, values, DM_TRAJ_REPLACE, &e); tostring shows the metadata keys
+ * system, method, stages, h.  dm_totraj: NULL unless an open Trajectory. */
+#define DM_TRAJ_MT "dmech.trajectory"
+struct dm_traj **dm_newtraj(lua_State *L);
+struct dm_traj *dm_pushtraj(lua_State *L, size_t n, const char *const *coords, unsigned flags);
+struct dm_traj *dm_totraj(lua_State *L, int arg);
+struct dm_traj *dm_checktraj(lua_State *L, int arg);
+void dm_open_traj(lua_State *L);
 
 /* ---- module opener ------------------------------------------------------------ */
 
