@@ -21,6 +21,11 @@
  *
  * Samples are indexed 0 .. len-1 in C (the Lua binding is 1-based).
  *
+ * Metadata keys producers should use (the Lua __tostring shows the first
+ * four): "system" (name), "method", "stages", "h", and "param.<name>" for
+ * each system parameter; values are strings (numbers written "%.17g" or
+ * shortest round-trip form).
+ *
  * Ownership: dm_traj_alloc / dm_traj_load / dm_traj_slice return a new
  * trajectory the caller releases with dm_traj_free (NULL is a no-op).  The
  * trajectory copies every name, key, value and number it is given.  Pointers
