@@ -117,6 +117,7 @@ gsl_matrix *dm_checkmatrix(lua_State *L, int arg, size_t rows, size_t cols);
 void dm_open_doc(lua_State *L);      /* dm.docs, dm.doc */
 void dm_open_linalg(lua_State *L);
 void dm_open_mat(lua_State *L);   /* part of dm_open_linalg */
+void dm_open_plot(lua_State *L);  /* dm.plot, dm.figure, dm.gnuplot (l_plot.c) */
 /* Trajectories (l_traj.c): the Trajectory class, dm.trajectory, dm.load_trajectory.
  * Bindings producing one (integrator runs): `dm_traj **slot = dm_newtraj(L);` pushes
  * an empty Trajectory that owns whatever *slot holds (set *slot = dm_traj_alloc(...)),

@@ -9,6 +9,7 @@ typedef void (*dm_opener)(lua_State *L);
 static const dm_opener openers[] = {
   dm_open_doc,
   dm_open_linalg,
+  dm_open_plot,
   dm_open_traj,
   NULL
 };

@@ -67,3 +67,35 @@ int dm_gp_valid_name(const char *name)
   }
   return 1;
 }
+
+/* A `with` style a user wrote: words, numbers, spaces, . , : # + - and
+ * quoted colour names ('#ff8800', "dark-red"); nothing that could end the
+ * command or call a function (; @ ` $ ( ) { } \ newline). */
+int dm_gp_valid_style(const char *style)
+{
+  const char *p;
+  if (style == NULL || style[0] == '\0' || strlen(style) > 200)
+    return 0;
+  for (p = style; *p != '\0'; p++) {
+    char c = *p;
+    if (c == '\'' || c == '"') {
+      const char *q = p + 1;
+      while (*q != '\0' && *q != c) {
+        char d = *q++;
+        if (!((d >= 'a' && d <= 'z') || (d >= 'A' && d <= 'Z')
+              || (d >= '0' && d <= '9') || d == '#' || d == '_' || d == ' '
+              || d == '-' || d == '.'))
+          return 0;
+      }
+      if (*q != c)
+        return 0;
+      p = q;
+      continue;
+    }
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z')
+          || (c >= '0' && c <= '9') || c == ' ' || c == '.' || c == ','
+          || c == ':' || c == '#' || c == '+' || c == '-' || c == '_'))
+      return 0;
+  }
+  return 1;
+}

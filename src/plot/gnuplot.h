@@ -174,9 +174,11 @@ typedef struct dm_gp_termreq {
   const char *terminal; /* the user's choice ("png", "qt", "dumb", "sixel"
                            with optional plain options), or NULL */
   const char *file;     /* output file, or NULL for the screen */
-  double width, height; /* size; 0 = terminal default.  Pixels for bitmap,
-                           svg and window terminals, characters for dumb,
-                           points (1/72 in) for pdf/eps */
+  double width, height; /* size; 0 = default (640x480 pixels, 79x24 or the
+                           terminal's size for dumb, 360x252 points, window
+                           terminals as they are).  Pixels for bitmap, svg
+                           and window terminals, characters for dumb, points
+                           (1/72 in) for pdf/eps */
   int window;           /* window number for window terminals (0, 1, ...) */
   int enhanced;         /* non-zero: enhanced text markup (default literal) */
 } dm_gp_termreq;
@@ -235,6 +237,11 @@ int dm_gp_set_terminal(dm_gp_session *s, const dm_gp_termreq *req,
  * needs, like snprintf. */
 size_t dm_gp_quote(char *dst, size_t size, const char *src, size_t len,
                    int flags);
+
+/* Non-zero when a user's plot style (the `with` clause) is safe to pass
+ * through: words, numbers, spaces, . , : # + - _ and quoted colour names;
+ * never ; @ ` $ ( ) { } \ or a newline. */
+int dm_gp_valid_style(const char *style);
 
 /* Non-zero when s is usable as a gnuplot identifier / datablock name. */
 int dm_gp_valid_name(const char *name);

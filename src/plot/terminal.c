@@ -220,9 +220,17 @@ int dm_gp_terminal_command(const dm_gp_session *s, const dm_gp_termreq *req,
   k = (size_t)snprintf(out, size, "set terminal %s", name);
   if (is_one_of(name, windows) && k < size)
     k += (size_t)snprintf(out + k, size - k, " %d", req->window);
-  if (w == 0 && strcmp(name, "dumb") == 0 && req->file == NULL && env->tty) {
-    w = env->cols > 20 ? env->cols : 20;
-    h = env->rows > 11 ? env->rows - 1 : 10;
+  /* gnuplot remembers a terminal's last size: always say which one */
+  if (w == 0 && strcmp(name, "dumb") == 0) {
+    int screen = req->file == NULL && env->tty;
+    w = screen ? (env->cols > 20 ? env->cols : 20) : 79;
+    h = screen ? (env->rows > 11 ? env->rows - 1 : 10) : 24;
+  } else if (w == 0 && is_one_of(name, paper)) {
+    w = 360;                                   /* 5in x 3.5in */
+    h = 252;
+  } else if (w == 0 && is_one_of(name, pixels) && !is_one_of(name, windows)) {
+    w = 640;
+    h = 480;
   }
   if (w > 0 && k < size) {
     if (is_one_of(name, paper))

@@ -130,6 +130,16 @@ static void test_quote_table(void)
          && !dm_gp_valid_name("1a") && !dm_gp_valid_name("a b")
          && !dm_gp_valid_name("a;b") && !dm_gp_valid_name(""),
          "datablock names: identifiers only");
+  tap_ok(dm_gp_valid_style("lines") && dm_gp_valid_style("linespoints pt 7 ps 0.5")
+         && dm_gp_valid_style("lines lc rgb '#ff8800' lw 2.385")
+         && dm_gp_valid_style("points lc rgb \"dark-red\""),
+         "plain styles accepted");
+  tap_ok(!dm_gp_valid_style("lines; system('touch x')")
+         && !dm_gp_valid_style("lines lc rgb 'a;b'") && !dm_gp_valid_style("lines @m")
+         && !dm_gp_valid_style("lines `x`") && !dm_gp_valid_style("lines\nplot")
+         && !dm_gp_valid_style("lines lc rgb 'open") && !dm_gp_valid_style("")
+         && !dm_gp_valid_style("l $dm1") && !dm_gp_valid_style("lines \\"),
+         "styles that could inject refused");
 }
 
 /* }==== */
@@ -200,6 +210,11 @@ static void test_terminal_command(dm_gp_session *s)
   rc = dm_gp_terminal_command(s, &req, &env, cmd, sizeof cmd, &e);
   tap_ok(rc == DM_OK && strcmp(cmd, "set terminal dumb size 100,39 noenhanced") == 0,
          "tty: dumb sized to the terminal: %s", cmd);
+  req.file = "x.svg";
+  rc = dm_gp_terminal_command(s, &req, &env, cmd, sizeof cmd, &e);
+  tap_ok(rc == DM_OK && strcmp(cmd, "set terminal svg size 640,480 noenhanced") == 0,
+         "default size is explicit (gnuplot would reuse the last): %s", cmd);
+  req.file = NULL;
   req.width = 3;
   rc = dm_gp_terminal_command(s, &req, &env, cmd, sizeof cmd, &e);
   tap_ok(rc == DM_EINVAL, "size with one zero refused: %s", e.msg);
