@@ -1,0 +1,48 @@
+/* builtin_systems.h -- hand-written C systems (the speed references for the
+ * benchmarks and the test systems of the integrators).
+ *
+ * Each constructor fills a caller-provided dm_system (its previous contents
+ * are ignored) and allocates the parameter vector, the mass matrix and the
+ * names; release them with dm_system_release().  On error (DM_ENOMEM,
+ * DM_EINVAL) *s is zeroed and nothing is leaked.  Parameters live in s->par
+ * under the names in s->params and may be changed between steps.
+ * All Lagrangians have unit mass unless stated; all derivatives are exact.
+ */
+#ifndef DM_BUILTIN_SYSTEMS_H
+#define DM_BUILTIN_SYSTEMS_H
+
+#include "status.h"
+#include "system.h"
+
+/* L = 1/2 v^2 - 1/2 omega^2 q^2 (n = 1; par: omega). Separable. */
+int dm_builtin_harmonic(dm_system *s, double omega, dm_err *e);
+
+/* L = 1/2 v^2 + k cos q (n = 1; par: k = g/l; spec T2.2 uses k = 1). Separable. */
+int dm_builtin_pendulum(dm_system *s, double k, dm_err *e);
+
+/* Kepler problem in dim = 2 or 3 Cartesian coordinates:
+ * L = 1/2 |v|^2 + mu / |q| (par: mu). Separable. */
+int dm_builtin_kepler(dm_system *s, int dim, double mu, dm_err *e);
+
+/* J2 satellite, Cartesian (x, y, z), non-dimensional (spec routh.md §8, the
+ * corrected potential):
+ *   V = -1/|q| + (J2/|q|^3) (3 z^2 / (2 |q|^2) - 1/2),  L = 1/2 |v|^2 - V.
+ * (par: J2). Separable. */
+int dm_builtin_j2(dm_system *s, double J2, dm_err *e);
+
+/* Damped oscillator: L = 1/2 v^2 - 1/2 omega^2 q^2 with the generalized force
+ * F = -c v (par: omega, c). Energy decays like exp(-c t) for light damping. */
+int dm_builtin_damped_oscillator(dm_system *s, double omega, double c, dm_err *e);
+
+/* Spherical pendulum in R^3 with one holonomic constraint:
+ *   L = 1/2 |v|^2 - g q3,   form 0: g(q) = |q|^2 - l^2,   form 1: g(q) = |q| - l
+ * (par: g, l). Separable. */
+int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, int form, dm_err *e);
+
+/* Spherical pendulum in spherical coordinates (theta from the downward
+ * vertical, phi azimuth), q = l (sin th cos ph, sin th sin ph, -cos th):
+ *   L = 1/2 l^2 (thdot^2 + sin^2 th phdot^2) + g l cos th   (par: g, l).
+ * Mechanical (not separable); phi is cyclic. */
+int dm_builtin_spherical_pendulum(dm_system *s, double g, double l, dm_err *e);
+
+#endif

@@ -1,0 +1,592 @@
+/* prk_engine.c -- implicit symplectic PRK step for a Lagrangian system.
+ *
+ * Unknowns are the s stage velocities V_i = Qdot_i (spec routh.md §3):
+ *   Q_i = q0 + h sum_j a_ij V_j,
+ *   R_i = Lv(Q_i, V_i) - p0 - h sum_j at_ij W_j = 0,   W_j = Lq(Q_j, V_j) + F(Q_j, V_j)
+ *   q1 = q0 + h sum_j b_j V_j,   p1 = p0 + h sum_j b_j W_j
+ * (W includes the generalized force: discrete Lagrange-d'Alembert, spec §6).
+ * Newton uses the exact Jacobian
+ *   dR_i/dV_k = d_ik Lvv_i + h a_ik Lvq_i - h at_ik (Lvq_k^T + Fv_k)
+ *               - h^2 sum_j at_ij a_jk (Lqq_j + Fq_j),
+ * factored with GSL LU, and iterates to round-off: stop when the scaled
+ * update is <= tol (default 10 eps), or, once the update is below
+ * DM_NEWTON_ACCEPT = 1e-10 (round-off regime of an ill-conditioned system),
+ * after two consecutive updates that did not halve; at most maxiter
+ * iterations (failure: DM_ENOCONV with the update, residual and tolerance).
+ * The predictor extrapolates the previous step's stage-velocity polynomial
+ * (nodes c, values V) to the new stage times; without history (or with
+ * repeated nodes) it starts from the previous stages or from v(q0, p0).
+ * q and p increments are added with Kahan compensation; the carries persist
+ * while steps continue from the previous output.
+ *
+ * The discrete Legendre transforms solve the boundary problem: unknowns V and
+ * p0 with sum_j b_j V_j = (q1 - q0)/h; then p1 = p0 + h sum b_j W_j and
+ * Ld = h sum b_i L(Q_i, V_i) (Suris; thesis Thm 2.12).
+ *
+ * The Jacobian of the step map comes from the implicit function theorem on
+ * R(V; q0, p0) = 0 at the converged stages:
+ *   dV = -J^{-1} [dR/dq0 | dR/dp0],  dR_i/dq0 = Lvq_i - h sum_j at_ij D_j,
+ *   dR_i/dp0 = -I, then dq1 = dq0 + h sum b_j dV_j,
+ *   dp1 = dp0 + h sum_j b_j (D_j dQ_j + Bm_j dV_j).
+ */
+#include <config.h>
+#include "prk_impl.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static size_t nunk(const dm_prk *P, int mode)
+{
+  switch (mode) {
+  case DM_PRK_CSTEP: return P->sn + P->nK * P->m + P->m;
+  case DM_PRK_DLEG: return P->sn + P->n;
+  default: return P->sn;
+  }
+}
+
+int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
+                 int maxiter, int explicit_sv, dm_prk **out, dm_err *e)
+{
+  dm_prk *P = calloc(1, sizeof *P);
+  size_t n = sys->n, s = t->s, m = sys->m, nn = n * n, sn = s * n, i, j, tot;
+  size_t extra;
+  double *d;
+  int st;
+  *out = NULL;
+  if (P == NULL)
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  P->sys = sys;
+  P->n = n;
+  P->s = s;
+  P->m = m;
+  P->sn = sn;
+  P->nn = nn;
+  P->forced = sys->force != NULL;
+  P->tol = tol;
+  P->maxiter = maxiter;
+  P->E_ratio = NAN;
+  if ((P->tab = dm_tableau_copy(t)) == NULL) {
+    free(P);
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  }
+  if (m > 0 && (st = dm_prk_constr_layout(P, e)) != DM_OK) {
+    dm_tableau_free(P->tab);
+    free(P);
+    return st;
+  }
+  extra = P->nK * m + m > n ? P->nK * m + m : n;
+  P->Nmax = sn + extra;
+  tot = P->Nmax * P->Nmax + 3 * P->Nmax + 5 * sn + 7 * s * nn + s
+        + (s + 2) * (m + m * n + m * nn) + 6 * n + P->Nmax * 2 * n
+        + sn + P->Nmax + 2 * n + s * s + 2 * n + nn + n;
+  d = calloc(tot, sizeof(double));
+  P->perm = calloc(P->Nmax, sizeof(size_t));
+  P->work = sys->work_size ? malloc(sys->work_size) : NULL;
+  P->leg = dm_legendre_alloc(sys);
+  if (d == NULL || P->perm == NULL || (sys->work_size && P->work == NULL) || P->leg == NULL) {
+    free(d);
+    P->Jm = NULL;
+    dm_prk_free(P);
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  }
+#define TAKE(ptr, cnt) do { (ptr) = d; d += (cnt); } while (0)
+  TAKE(P->Jm, P->Nmax * P->Nmax);
+  TAKE(P->R, P->Nmax);
+  TAKE(P->X, P->Nmax);
+  TAKE(P->hx, P->Nmax);
+  TAKE(P->Q, sn); TAKE(P->Lq, sn); TAKE(P->Lv, sn); TAKE(P->W, sn); TAKE(P->F, sn);
+  TAKE(P->Lvv, s * nn); TAKE(P->Lvq, s * nn); TAKE(P->Lqq, s * nn);
+  TAKE(P->Fq, s * nn); TAKE(P->Fv, s * nn); TAKE(P->D, s * nn); TAKE(P->Bm, s * nn);
+  TAKE(P->Lval, s);
+  TAKE(P->g, (s + 2) * m); TAKE(P->G, (s + 2) * m * n); TAKE(P->Hc, (s + 2) * m * nn);
+  TAKE(P->q1w, n); TAKE(P->p1w, n); TAKE(P->v1w, n); TAKE(P->dq, n); TAKE(P->dp, n);
+  TAKE(P->tmp, n);
+  TAKE(P->rhs, P->Nmax * 2 * n);
+  TAKE(P->hV, sn); TAKE(P->hq1, n); TAKE(P->hp1, n); TAKE(P->E, s * s);
+  TAKE(P->cq, n); TAKE(P->cp, n); TAKE(P->Minv, nn); TAKE(P->svf, n);
+#undef TAKE
+  P->distinct_nodes = 1;
+  for (i = 0; i < s; i++)
+    for (j = 0; j < i; j++)
+      if (fabs(t->c[i] - t->c[j]) < 1e-8)
+        P->distinct_nodes = 0;
+  if (explicit_sv && (st = dm_prk_verlet_setup(P, e)) != DM_OK) {
+    dm_prk_free(P);
+    return st;
+  }
+  *out = P;
+  return DM_OK;
+}
+
+void dm_prk_free(dm_prk *P)
+{
+  if (P == NULL)
+    return;
+  free(P->Jm);
+  free(P->perm);
+  free(P->work);
+  dm_legendre_free(P->leg);
+  dm_tableau_free(P->tab);
+  free(P);
+}
+
+void dm_prk_reset(dm_prk *P)
+{
+  P->hist = 0;
+  P->svf_valid = 0;
+  P->E_ratio = NAN;
+  memset(P->cq, 0, P->n * sizeof(double));
+  memset(P->cp, 0, P->n * sizeof(double));
+}
+
+int dm_prk_is_explicit(const dm_prk *P)
+{
+  return P->explicit_sv;
+}
+
+void dm_prk_kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
+{
+  size_t i;
+  for (i = 0; i < n; i++) {
+    double y = dx[i] - carry[i];
+    double t = x0[i] + y;
+    carry[i] = (t - x0[i]) - y;
+    out[i] = t;
+  }
+}
+
+/* Evaluate L (and the force) at stage i: gradients always, second
+ * derivatives when jac; W, D, Bm derived. */
+int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
+{
+  size_t n = P->n, nn = P->nn, a, b;
+  double *Qi = P->Q + i * n, *Vi = P->X + i * n;
+  dm_lag_out o = {0, P->Lq + i * n, P->Lv + i * n, P->Lvv + i * nn, P->Lvq + i * nn,
+                  P->Lqq + i * nn};
+  unsigned what = DM_LAG_Q | DM_LAG_V | (want_L ? DM_LAG_L : 0u)
+                  | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
+  int st = dm_eval_lag(P->sys, Qi, Vi, what, &o, P->work, e);
+  if (st != DM_OK)
+    return st;
+  P->Lval[i] = o.L;
+  if (P->forced) {
+    unsigned fw = DM_FORCE_F | (jac ? (DM_FORCE_Q | DM_FORCE_V) : 0u);
+    st = dm_eval_force(P->sys, Qi, Vi, fw, P->F + i * n, P->Fq + i * nn, P->Fv + i * nn,
+                       P->work, e);
+    if (st != DM_OK)
+      return st;
+  }
+  for (a = 0; a < n; a++)
+    P->W[i * n + a] = P->Lq[i * n + a] + P->F[i * n + a];
+  if (jac)
+    for (a = 0; a < n; a++)
+      for (b = 0; b < n; b++) {
+        P->D[i * nn + a * n + b] = P->Lqq[i * nn + a * n + b] + P->Fq[i * nn + a * n + b];
+        P->Bm[i * nn + a * n + b] = P->Lvq[i * nn + b * n + a] + P->Fv[i * nn + a * n + b];
+      }
+  return DM_OK;
+}
+
+/* Residual (and Newton matrix when jac) of the stage equations at X. */
+static int assemble(dm_prk *P, int mode, double h, const double *q0, const double *p0,
+                    const double *q1t, int jac, dm_err *e)
+{
+  size_t n = P->n, s = P->s, nn = P->nn, sn = P->sn, N = nunk(P, mode);
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  const double *V = P->X, *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
+  size_t i, j, k, a, c;
+  int st;
+  for (i = 0; i < s; i++)
+    for (a = 0; a < n; a++) {
+      double acc = 0.0;
+      for (j = 0; j < s; j++)
+        acc += A[i * s + j] * V[j * n + a];
+      P->Q[i * n + a] = q0[a] + h * acc;
+    }
+  for (i = 0; i < s; i++)
+    if ((st = dm_prk_eval_stage(P, i, jac, mode == DM_PRK_DLEG, e)) != DM_OK)
+      return st;
+  for (i = 0; i < s; i++)
+    for (a = 0; a < n; a++) {
+      double acc = 0.0;
+      for (j = 0; j < s; j++)
+        acc += At[i * s + j] * P->W[j * n + a];
+      P->R[i * n + a] = P->Lv[i * n + a] - pp[a] - h * acc;
+    }
+  if (mode == DM_PRK_DLEG)
+    for (a = 0; a < n; a++) {
+      double acc = 0.0;
+      for (j = 0; j < s; j++)
+        acc += b[j] * V[j * n + a];
+      P->R[sn + a] = acc - (q1t[a] - q0[a]) / h;
+    }
+  if (jac) {
+    memset(P->Jm, 0, N * N * sizeof(double));
+    for (i = 0; i < s; i++)
+      for (k = 0; k < s; k++) {
+        double hak = h * A[i * s + k], hatk = h * At[i * s + k];
+        double *Jb = P->Jm + (i * n) * N + k * n;
+        for (a = 0; a < n; a++)
+          for (c = 0; c < n; c++) {
+            double v = hak * P->Lvq[i * nn + a * n + c] - hatk * P->Bm[k * nn + a * n + c];
+            if (i == k)
+              v += P->Lvv[i * nn + a * n + c];
+            for (j = 0; j < s; j++)
+              v -= h * h * At[i * s + j] * A[j * s + k] * P->D[j * nn + a * n + c];
+            Jb[a * N + c] = v;
+          }
+      }
+    if (mode == DM_PRK_DLEG)
+      for (i = 0; i < s; i++)
+        for (a = 0; a < n; a++) {
+          P->Jm[(i * n + a) * N + sn + a] = -1.0;
+          P->Jm[(sn + a) * N + i * n + a] = b[i];
+        }
+  }
+  if (mode == DM_PRK_CSTEP)
+    return dm_prk_constr_assemble(P, h, q0, jac, e);
+  return DM_OK;
+}
+
+/* Scaled size of the Newton update held in R: velocities relative to
+ * max(|V|, momentum scale / |Lvv|), multipliers and p0 relative to
+ * max(|x|, momentum scale) with momentum scale |p| + |h| |W|. */
+static double update_norm(const dm_prk *P, int mode, double h, const double *p0)
+{
+  size_t sn = P->sn, N = nunk(P, mode);
+  const double *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
+  double ms = dm_norm_inf(pp, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
+  double lv = dm_norm_inf(P->Lvv, P->s * P->nn);
+  double vs = fmax(fmax(dm_norm_inf(P->X, sn), lv > 0 ? ms / lv : 0.0), DBL_MIN);
+  double d = dm_norm_inf(P->R, sn) / vs;
+  if (N > sn) {
+    double xs = fmax(fmax(dm_norm_inf(P->X + sn, N - sn), ms), DBL_MIN);
+    d = fmax(d, dm_norm_inf(P->R + sn, N - sn) / xs);
+  }
+  return d;
+}
+
+int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
+{
+  size_t n = P->n, i;
+  int sg;
+  char bq[160], bv[160];
+  for (i = 0; i < P->s; i++) {
+    memcpy(P->Jm, P->Lvv + i * P->nn, P->nn * sizeof(double));
+    if (dm_lu_factor(P->Jm, n, P->perm, &sg) != DM_OK)
+      return dm_err_set(e, DM_ESINGULAR,
+                        "d2L/dv2 is singular at stage %zu (q = %s, v = %s): the Lagrangian of "
+                        "'%s' is not regular (its Hessian in the velocities must be invertible)",
+                        i + 1, dm_fmt_vec(bq, sizeof bq, P->Q + i * n, n),
+                        dm_fmt_vec(bv, sizeof bv, P->X + i * n, n),
+                        P->sys->name ? P->sys->name : "system");
+  }
+  return dm_err_set(e, DM_ESINGULAR, "singular Newton matrix of the %s (h = %g)%s", what, h,
+                    P->m ? "; the constraint gradients may be linearly dependent"
+                         : "; try a smaller step");
+}
+
+static int newton(dm_prk *P, int mode, double h, const double *q0, const double *p0,
+                  const double *q1t, dm_integ_stats *stt, dm_err *e)
+{
+  size_t N = nunk(P, mode), i;
+  double d = HUGE_VAL, dprev = HUGE_VAL, rn = HUGE_VAL;
+  int it, st, sg, stall = 0, ok = 0;
+  for (it = 1; it <= P->maxiter; it++) {
+    if ((st = assemble(P, mode, h, q0, p0, q1t, 1, e)) != DM_OK)
+      return st;
+    rn = dm_norm_inf(P->R, N);
+    if (!isfinite(rn))
+      return dm_err_set(e, DM_EDOM, "non-finite residual in the stage equations (h = %g, iteration %d)",
+                        h, it);
+    st = dm_lu_factor(P->Jm, N, P->perm, &sg);
+    if (st == DM_ESINGULAR)
+      return dm_prk_singular(P, "stage equations", h, e);
+    if (st != DM_OK)
+      return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
+    dm_lu_solve(P->Jm, N, P->perm, P->R);
+    for (i = 0; i < N; i++)
+      P->X[i] -= P->R[i];
+    d = update_norm(P, mode, h, p0);
+    if (!isfinite(d))
+      return dm_err_set(e, DM_EDOM, "non-finite Newton update (h = %g)", h);
+    if (d <= P->tol) {
+      ok = 1;
+      break;
+    }
+    /* in the round-off regime, stop once the updates stop contracting */
+    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
+    if (stall >= 2) {
+      ok = 1;
+      break;
+    }
+    dprev = d;
+  }
+  if (it > P->maxiter)
+    it = P->maxiter;
+  if (stt) {
+    stt->iters = it;
+    stt->residual = d;
+    stt->tol = P->tol;
+    stt->iters_total += it;
+  }
+  if (!ok)
+    return dm_err_set(e, DM_ENOCONV,
+                      "Newton on the stage equations did not converge in %d iterations: "
+                      "relative update %.3g > tol %.3g (residual %.3g, h = %g)",
+                      it, d, P->tol, rn, h);
+  return assemble(P, mode, h, q0, p0, q1t, 0, e);
+}
+
+static double lagrange_d(size_t s, const double *c, size_t j, double x)
+{
+  double v = 1.0;
+  size_t k;
+  for (k = 0; k < s; k++)
+    if (k != j)
+      v *= (x - c[k]) / (c[j] - c[k]);
+  return v;
+}
+
+static int predict(dm_prk *P, double h, const double *q0, const double *p0, int cont,
+                   dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, j, a, N = nunk(P, P->m ? DM_PRK_CSTEP : DM_PRK_STEP);
+  if (cont && P->distinct_nodes) {
+    double r = h / P->hist_h;
+    if (r != P->E_ratio) {
+      for (i = 0; i < s; i++)
+        for (j = 0; j < s; j++)
+          P->E[i * s + j] = lagrange_d(s, P->tab->c, j, 1.0 + r * P->tab->c[i]);
+      P->E_ratio = r;
+    }
+    for (i = 0; i < s; i++)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += P->E[i * s + j] * P->hV[j * n + a];
+        P->X[i * n + a] = acc;
+      }
+  } else if (cont) {
+    memcpy(P->X, P->hV, sn * sizeof(double));
+  } else {
+    int st;
+    if (P->hist)
+      memcpy(P->v1w, P->hV + (s - 1) * n, n * sizeof(double));
+    st = dm_legendre_velocity(P->leg, q0, p0, P->v1w, P->hist, e);
+    if (st != DM_OK)
+      return st;
+    for (i = 0; i < s; i++)
+      memcpy(P->X + i * n, P->v1w, n * sizeof(double));
+  }
+  if (N > sn) {
+    if (cont)
+      memcpy(P->X + sn, P->hx, (N - sn) * sizeof(double));
+    else
+      memset(P->X + sn, 0, (N - sn) * sizeof(double));
+  }
+  return DM_OK;
+}
+
+int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
+                double *q1, double *p1, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, a;
+  const double *b = P->tab->b;
+  int mode = P->m ? DM_PRK_CSTEP : DM_PRK_STEP, st;
+  int cont = P->hist && memcmp(q0, P->hq1, n * sizeof(double)) == 0
+             && memcmp(p0, P->hp1, n * sizeof(double)) == 0;
+  if (!cont) {
+    memset(P->cq, 0, n * sizeof(double));
+    memset(P->cp, 0, n * sizeof(double));
+    P->svf_valid = 0;
+  }
+  if (h == 0.0) {
+    memmove(q1, q0, n * sizeof(double));
+    memmove(p1, p0, n * sizeof(double));
+    return DM_OK;
+  }
+  if (P->explicit_sv) {
+    st = dm_prk_verlet_step(P, h, q0, p0, cont, P->q1w, P->p1w, stt, e);
+  } else {
+    st = predict(P, h, q0, p0, cont, e);
+    if (st == DM_OK && P->m)
+      st = dm_prk_constr_begin(P, q0, e);
+    if (st == DM_OK)
+      st = newton(P, mode, h, q0, p0, NULL, stt, e);
+    if (st == DM_OK && P->m) {
+      st = dm_prk_constr_finish(P, h, q0, p0, P->q1w, P->p1w, e);
+    } else if (st == DM_OK) {
+      for (a = 0; a < n; a++) {
+        double sq = 0.0, sp = 0.0;
+        for (i = 0; i < s; i++) {
+          sq += b[i] * P->X[i * n + a];
+          sp += b[i] * P->W[i * n + a];
+        }
+        P->dq[a] = h * sq;
+        P->dp[a] = h * sp;
+      }
+      dm_prk_kahan(n, q0, P->dq, P->cq, P->q1w);
+      dm_prk_kahan(n, p0, P->dp, P->cp, P->p1w);
+    }
+  }
+  if (st != DM_OK) {
+    P->hist = 0;
+    P->svf_valid = 0;
+    return st;
+  }
+  memcpy(P->hV, P->X, sn * sizeof(double));
+  if (P->Nmax > sn)
+    memcpy(P->hx, P->X + sn, (P->Nmax - sn) * sizeof(double));
+  memcpy(P->hq1, P->q1w, n * sizeof(double));
+  memcpy(P->hp1, P->p1w, n * sizeof(double));
+  P->hist_h = h;
+  P->hist = 1;
+  memcpy(q1, P->q1w, n * sizeof(double));
+  memcpy(p1, P->p1w, n * sizeof(double));
+  if (stt)
+    stt->steps++;
+  return DM_OK;
+}
+
+int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
+                    double *DPhi, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, nn = P->nn, N2 = 2 * n, i, j, k, a, c, x;
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  int st, sg;
+  if (P->m)
+    return dm_err_set(e, DM_EUNSUP, "the step Jacobian is not available for constrained systems");
+  if ((st = dm_prk_step(P, h, q0, p0, DPhi, DPhi + n, stt, e)) != DM_OK)
+    return st;
+  if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, NULL, 1, e)) != DM_OK)
+    return st;
+  if (dm_lu_factor(P->Jm, sn, P->perm, &sg) != DM_OK)
+    return dm_prk_singular(P, "stage equations", h, e);
+  for (c = 0; c < N2; c++) {
+    double *dV = P->rhs + c * sn;
+    for (i = 0; i < s; i++)
+      for (a = 0; a < n; a++) {
+        double v;
+        if (c < n) {
+          v = P->Lvq[i * nn + a * n + c];
+          for (j = 0; j < s; j++)
+            v -= h * At[i * s + j] * P->D[j * nn + a * n + c];
+        } else {
+          v = (a == c - n) ? -1.0 : 0.0;
+        }
+        dV[i * n + a] = -v;
+      }
+    dm_lu_solve(P->Jm, sn, P->perm, dV);
+    /* dQ_j = e_c (q part) + h sum_k a_jk dV_k, stored in Q as scratch */
+    for (j = 0; j < s; j++)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (k = 0; k < s; k++)
+          acc += A[j * s + k] * dV[k * n + a];
+        P->Q[j * n + a] = (c < n && a == c ? 1.0 : 0.0) + h * acc;
+      }
+    for (a = 0; a < n; a++) {
+      double dq1 = 0.0, dp1 = 0.0;
+      for (j = 0; j < s; j++) {
+        double f = 0.0;
+        dq1 += b[j] * dV[j * n + a];
+        for (x = 0; x < n; x++)
+          f += P->D[j * nn + a * n + x] * P->Q[j * n + x] + P->Bm[j * nn + a * n + x] * dV[j * n + x];
+        dp1 += b[j] * f;
+      }
+      DPhi[a * N2 + c] = (c == a ? 1.0 : 0.0) + h * dq1;
+      DPhi[(n + a) * N2 + c] = (c == n + a ? 1.0 : 0.0) + h * dp1;
+    }
+  }
+  return DM_OK;
+}
+
+int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
+                     double *p0, double *p1, double *Ld, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, a;
+  const double *b = P->tab->b;
+  int st;
+  if (P->m)
+    return dm_err_set(e, DM_EUNSUP,
+                      "discrete Legendre transforms are not available for constrained systems");
+  if (h == 0.0)
+    return dm_err_set(e, DM_EINVAL, "discrete Legendre transform needs h != 0");
+  for (i = 0; i < s; i++)
+    for (a = 0; a < n; a++)
+      P->X[i * n + a] = (q1[a] - q0[a]) / h;
+  memset(P->X + sn, 0, n * sizeof(double));
+  if ((st = newton(P, DM_PRK_DLEG, h, q0, NULL, q1, stt, e)) != DM_OK)
+    return st;
+  if (Ld) {
+    *Ld = 0.0;
+    for (i = 0; i < s; i++)
+      *Ld += h * b[i] * P->Lval[i];
+  }
+  for (a = 0; a < n; a++) {
+    double acc = 0.0;
+    for (i = 0; i < s; i++)
+      acc += b[i] * P->W[i * n + a];
+    P->tmp[a] = P->X[sn + a] + h * acc;
+  }
+  if (p0)
+    memcpy(p0, P->X + sn, n * sizeof(double));
+  if (p1)
+    memcpy(p1, P->tmp, n * sizeof(double));
+  return DM_OK;
+}
+
+/* {==== type-object glue for the PRK families ============================ */
+
+int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
+{
+  dm_prk *P;
+  int st = dm_prk_alloc(I->sys, t, I->opt.tol, I->opt.maxiter, I->opt.explicit_sv, &P, e);
+  if (st != DM_OK)
+    return st;
+  I->state = P;
+  I->order = t->order;
+  I->flags = DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;
+  if (I->m == 0)
+    I->flags |= DM_INTEG_EXACT_JAC;
+  if (t->flags & DM_TAB_SYMPLECTIC)
+    I->flags |= DM_INTEG_SYMPLECTIC;
+  if (t->flags & DM_TAB_SYMMETRIC)
+    I->flags |= DM_INTEG_SYMMETRIC;
+  if (P->explicit_sv)
+    I->flags |= DM_INTEG_EXPLICIT;
+  return DM_OK;
+}
+
+int dm_prk_type_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                     double *q1, double *p1, dm_err *e)
+{
+  return dm_prk_step(I->state, h, q0, p0, q1, p1, &I->stats, e);
+}
+
+int dm_prk_type_jacobian(dm_integrator *I, double h, const double *q0,
+                         const double *p0, double *DPhi, dm_err *e)
+{
+  return dm_prk_jacobian(I->state, h, q0, p0, DPhi, &I->stats, e);
+}
+
+int dm_prk_type_dlegendre(dm_integrator *I, double h, const double *q0,
+                          const double *q1, double *p0, double *p1, double *Ld,
+                          dm_err *e)
+{
+  return dm_prk_dlegendre(I->state, h, q0, q1, p0, p1, Ld, &I->stats, e);
+}
+
+void dm_prk_type_reset(dm_integrator *I)
+{
+  dm_prk_reset(I->state);
+}
+
+void dm_prk_type_free(dm_integrator *I)
+{
+  dm_prk_free(I->state);
+  I->state = NULL;
+}

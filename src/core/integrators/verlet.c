@@ -1,0 +1,195 @@
+/* verlet.c -- explicit paths of the Lobatto IIIA-IIIB s=2 (trapezoid) step
+ * for separable unforced systems L = 1/2 v^T M v - V(q):
+ *   Stormer-Verlet (velocity Verlet)
+ *     p_half = p0 + h/2 Lq(q0),  q1 = q0 + h M^{-1} p_half,  p1 = p_half + h/2 Lq(q1)
+ *   and, with constraints g(q) = 0, RATTLE:
+ *     p_half = p0 + h/2 Lq(q0) - G(q0)^T mu0, with mu0 (m unknowns, Newton
+ *     on g(q1(mu0)) = 0: SHAKE), then p1 = p_half + h/2 Lq(q1) - G(q1)^T mu1
+ *     with mu1 making M^{-1} p1 tangent (momentum projection).
+ * These are exactly the engine's Lobatto-2 step equations (stage velocities
+ * V_1 = V_2 = M^{-1} p_half), so the implicit-function Jacobian of
+ * prk_engine.c applies unchanged.  Lq at q1 is kept for the next step
+ * (first same as last): one force evaluation per step. */
+#include <config.h>
+#include "prk_impl.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include <gsl/gsl_linalg.h>
+
+static int is_lobatto2(const dm_tableau *t)
+{
+  return t->s == 2 && t->c[0] == 0.0 && t->c[1] == 1.0 && t->a[0] == 0.0 && t->a[1] == 0.0
+         && t->a[2] == 0.5 && t->a[3] == 0.5 && t->at[0] == 0.5 && t->at[1] == 0.0
+         && t->at[2] == 0.5 && t->at[3] == 0.0 && t->b[0] == 0.5 && t->b[1] == 0.5;
+}
+
+int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
+{
+  const dm_system *sys = P->sys;
+  size_t n = P->n;
+  gsl_matrix_view Mi;
+  P->explicit_sv = 0;
+  if (!is_lobatto2(P->tab) || !(sys->flags & DM_SYS_SEPARABLE) || sys->mass == NULL || P->forced)
+    return DM_OK;
+  memcpy(P->Minv, sys->mass, n * n * sizeof(double));
+  Mi = gsl_matrix_view_array(P->Minv, n, n);
+  if (gsl_linalg_cholesky_decomp1(&Mi.matrix) != 0 || gsl_linalg_cholesky_invert(&Mi.matrix) != 0)
+    return dm_err_set(e, DM_EINVAL, "system '%s' is flagged separable but its mass matrix is not "
+                      "symmetric positive definite", sys->name ? sys->name : "?");
+  P->explicit_sv = 1;
+  return DM_OK;
+}
+
+static int force_at(dm_prk *P, const double *q, double *f, dm_err *e)
+{
+  dm_lag_out o = {0, f, P->Lv + P->n, NULL, NULL, NULL};
+  memset(P->v1w, 0, P->n * sizeof(double));   /* Lq of a separable L ignores v */
+  return dm_eval_lag(P->sys, q, P->v1w, DM_LAG_Q, &o, P->work, e);
+}
+
+static void minv_mul(const dm_prk *P, const double *x, double *y)
+{
+  size_t n = P->n, i, j;
+  for (i = 0; i < n; i++) {
+    double acc = 0.0;
+    for (j = 0; j < n; j++)
+      acc += P->Minv[i * n + j] * x[j];
+    y[i] = acc;
+  }
+}
+
+/* SHAKE: mu0 with g(q0 + h M^{-1}(base - G0^T mu0)) = 0; leaves u = M^{-1} p_half
+ * in X[0..n) and mu0 in X[2n..2n+m). */
+static int shake(dm_prk *P, double h, const double *q0, const double *base, const double *G0,
+                 double ms, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, m = P->m, a, b, c;
+  double *u = P->X, *mu = P->X + 2 * n, *qq = P->tmp, *gq = P->g, *Gq = P->G, *ph = P->dp;
+  double d = HUGE_VAL, dprev = HUGE_VAL;
+  int it, st, sg, stall = 0;
+  for (it = 1; it <= P->maxiter; it++) {
+    for (c = 0; c < n; c++) {
+      double acc = base[c];
+      for (a = 0; a < m; a++)
+        acc -= G0[a * n + c] * mu[a];
+      ph[c] = acc;
+    }
+    minv_mul(P, ph, u);
+    for (c = 0; c < n; c++)
+      qq[c] = q0[c] + h * u[c];
+    if ((st = dm_eval_constr(P->sys, qq, DM_CONSTR_G | DM_CONSTR_DG, gq, Gq, NULL, P->work, e)) != DM_OK)
+      return st;
+    /* d(g/h)/dmu0_b = -G(qq) M^{-1} G0_b^T */
+    for (b = 0; b < m; b++) {
+      minv_mul(P, G0 + b * n, P->q1w);
+      for (a = 0; a < m; a++) {
+        double acc = 0.0;
+        for (c = 0; c < n; c++)
+          acc += Gq[a * n + c] * P->q1w[c];
+        P->Jm[a * m + b] = -acc;
+      }
+    }
+    for (a = 0; a < m; a++)
+      P->R[a] = gq[a] / h;
+    if (!isfinite(dm_norm_inf(P->R, m)))
+      return dm_err_set(e, DM_EDOM, "SHAKE: non-finite constraint residual (h = %g)", h);
+    if ((st = dm_lu_factor(P->Jm, m, P->perm, &sg)) != DM_OK)
+      return dm_err_set(e, DM_ESINGULAR, "SHAKE: singular constraint matrix G(q1) M^-1 G(q0)^T "
+                        "(h = %g too large, or dependent constraints)", h);
+    dm_lu_solve(P->Jm, m, P->perm, P->R);
+    for (a = 0; a < m; a++)
+      mu[a] -= P->R[a];
+    d = dm_norm_inf(P->R, m) / fmax(fmax(dm_norm_inf(mu, m), ms), DBL_MIN);
+    if (d <= P->tol)
+      break;
+    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
+    if (stall >= 2)
+      break;
+    dprev = d;
+  }
+  if (stt) {
+    stt->iters = it > P->maxiter ? P->maxiter : it;
+    stt->residual = d;
+    stt->tol = P->tol;
+    stt->iters_total += stt->iters;
+  }
+  if (it > P->maxiter)
+    return dm_err_set(e, DM_ENOCONV, "SHAKE iteration for the position constraints did not converge: "
+                      "relative update %.3g > tol %.3g (h = %g)", d, P->tol, h);
+  for (c = 0; c < n; c++) {
+    double acc = base[c];
+    for (a = 0; a < m; a++)
+      acc -= G0[a * n + c] * mu[a];
+    ph[c] = acc;
+  }
+  minv_mul(P, ph, u);
+  return DM_OK;
+}
+
+int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
+                       int cont, double *q1, double *p1, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, m = P->m, a, c;
+  double *f0 = P->Lq, *f1 = P->Lq + n, *u = P->X, *ph = P->dp;
+  int st;
+  if (cont && P->svf_valid)
+    memcpy(f0, P->svf, n * sizeof(double));
+  else if ((st = force_at(P, q0, f0, e)) != DM_OK)
+    return st;
+  P->svf_valid = 0;
+  if (m == 0) {
+    for (c = 0; c < n; c++)
+      ph[c] = p0[c] + 0.5 * h * f0[c];
+    minv_mul(P, ph, u);
+    if (stt) {
+      stt->iters = 0;
+      stt->residual = 0.0;
+      stt->tol = P->tol;
+    }
+  } else {
+    double *base = P->W, *G0 = P->G + P->s * m * n;
+    if ((st = dm_prk_constr_begin(P, q0, e)) != DM_OK)
+      return st;
+    for (c = 0; c < n; c++)
+      base[c] = p0[c] + 0.5 * h * f0[c];
+    if (!cont)
+      memset(P->X + 2 * n, 0, m * sizeof(double));
+    else
+      memcpy(P->X + 2 * n, P->hx, m * sizeof(double));
+    if ((st = shake(P, h, q0, base, G0, dm_norm_inf(base, n), stt, e)) != DM_OK)
+      return st;
+  }
+  for (c = 0; c < n; c++)
+    P->dq[c] = h * u[c];
+  memcpy(P->X + n, u, n * sizeof(double));
+  dm_prk_kahan(n, q0, P->dq, P->cq, q1);
+  if ((st = force_at(P, q1, f1, e)) != DM_OK)
+    return st;
+  memcpy(P->svf, f1, n * sizeof(double));
+  /* dp accumulated in W + n.. as the increment p1 - p0 */
+  {
+    double *dp = P->W + n, *pp = P->Q, *pp0 = P->Q + n;
+    for (c = 0; c < n; c++)
+      dp[c] = 0.5 * h * (f0[c] + f1[c]);
+    if (m > 0) {
+      double *G0 = P->G + P->s * m * n, *G1 = P->G + (P->s + 1) * m * n, *mu0 = P->X + 2 * n;
+      for (c = 0; c < n; c++)
+        for (a = 0; a < m; a++)
+          dp[c] -= G0[a * n + c] * mu0[a];
+      if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, P->g + (P->s + 1) * m, G1,
+                               NULL, P->work, e)) != DM_OK)
+        return st;
+      for (c = 0; c < n; c++)
+        pp[c] = pp0[c] = p0[c] + dp[c];
+      if ((st = dm_prk_project_momentum(P, q1, G1, pp, u, e)) != DM_OK)
+        return st;
+      for (c = 0; c < n; c++)
+        dp[c] += pp[c] - pp0[c];
+    }
+    dm_prk_kahan(n, p0, dp, P->cp, p1);
+  }
+  P->svf_valid = 1;
+  return DM_OK;
+}
