@@ -1,22 +1,32 @@
 /* escape.c -- user strings as gnuplot string expressions.
  *
- * Inside gnuplot single quotes nothing is special except the quote itself:
- * no backslash escapes, no `@macro` expansion, no backtick command
- * substitution.  gnuplot documents '' as a quote inside single quotes, but
- * its scanner (5.4) mis-reads a string that starts with '' or has two ''
- * in a row, so a quote is written as the concatenation '."'".' instead, and
- * a newline (which a single-quoted string cannot hold) as '."\n".' --
- * every place that takes a string (titles, labels, key entries, file
- * names) takes a string expression.  Other control characters (including
- * NUL) become spaces, so nothing a user writes can end the command line.
+ * gnuplot reads a command line with several scanners that each track
+ * quotes their own way: the lexer, the `@macro` expander and the backtick
+ * command substitution.  They agree only on simple single-quoted text.
+ * Measured with 5.4: '' (the documented quote-in-quotes) breaks the lexer
+ * when two come in a row or at the start, and a quote inside a double-quoted
+ * piece ('a'."'".'b @m') flips the macro expander's idea of "inside quotes",
+ * so a later @m is expanded.  Hence the encoding: runs of ordinary
+ * characters go in single quotes; every character that any scanner treats
+ * specially -- ' " \ ` @ -- and newlines go as octal escapes in a
+ * double-quoted piece ("\047"), so the text sent contains no quote, backtick,
+ * at-sign or backslash-before-quote that a scanner could misread:
+ *
+ *     it's @home  ->  'it'."\047".'s '."\100".'home'
+ *
+ * Other control characters (including NUL) become spaces, so nothing a
+ * user writes can end the command line.  Every place that takes a string
+ * (titles, labels, key entries, file names) takes a string expression.
  */
 #include <config.h>
 
+#include <stdio.h>
 #include <string.h>
 
 #include "plot/gnuplot.h"
 
-/* Append c to dst if it fits (keeping room for the NUL); count it anyway. */
+/* Append s[0..n) to dst if it fits (keeping room for the NUL); count it
+ * anyway. */
 static void put(char *dst, size_t size, size_t *k, const char *s, size_t n)
 {
   size_t i;
@@ -25,30 +35,52 @@ static void put(char *dst, size_t size, size_t *k, const char *s, size_t n)
       dst[*k] = s[i];
 }
 
+/* 0: ordinary, 1: octal escape, 2: becomes a space; newline handled apart */
+static int klass(unsigned char c)
+{
+  if (c == '\'' || c == '"' || c == '\\' || c == '`' || c == '@')
+    return 1;
+  if ((c < 0x20 && c != '\t') || c == 0x7f)
+    return 2;
+  return 0;
+}
+
 size_t dm_gp_quote(char *dst, size_t size, const char *src, size_t len,
                    int flags)
 {
-  static const char nl[] = "'.\"\\n\".'", quote[] = "'.\"'\".'";
   size_t i, k = 0;
-  put(dst, size, &k, "'", 1);
+  int state = 0;   /* 0: nothing yet, 1: inside '...', 2: inside "..." */
   for (i = 0; i < len; i++) {
     unsigned char c = (unsigned char)src[i];
-    if (c == '\r' || c == '\n') {
-      if (c == '\r' && i + 1 < len && src[i + 1] == '\n')
-        i++;
-      if (flags & DM_GP_QUOTE_ONELINE)
-        put(dst, size, &k, " ", 1);
-      else
-        put(dst, size, &k, nl, sizeof nl - 1);
-    } else if (c == '\'') {
-      put(dst, size, &k, quote, sizeof quote - 1);
-    } else if ((c < 0x20 && c != '\t') || c == 0x7f) {
-      put(dst, size, &k, " ", 1);
+    int nl = c == '\n' || c == '\r', cls = nl ? 1 : klass(c);
+    if (nl && (flags & DM_GP_QUOTE_ONELINE)) {
+      cls = 0;
+      c = ' ';
+    } else if (cls == 2) {
+      cls = 0;
+      c = ' ';
+    }
+    if (nl && c == '\r' && i + 1 < len && src[i + 1] == '\n')
+      i++;                                      /* \r\n is one newline */
+    if (cls == 0 && state != 1) {
+      put(dst, size, &k, state == 2 ? "\".'" : "'", state == 2 ? 3 : 1);
+      state = 1;
+    } else if (cls == 1 && state != 2) {
+      put(dst, size, &k, state == 1 ? "'.\"" : "\"", state == 1 ? 3 : 1);
+      state = 2;
+    }
+    if (cls == 0) {
+      put(dst, size, &k, (const char *)&c, 1);
     } else {
-      put(dst, size, &k, (const char *)&src[i], 1);
+      char oct[8];
+      snprintf(oct, sizeof oct, "\\%03o", nl ? '\n' : c);
+      put(dst, size, &k, oct, 4);
     }
   }
-  put(dst, size, &k, "'", 1);
+  if (state == 0)
+    put(dst, size, &k, "''", 2);
+  else
+    put(dst, size, &k, state == 1 ? "'" : "\"", 1);
   if (size > 0)
     dst[k < size ? k : size - 1] = '\0';
   return k;

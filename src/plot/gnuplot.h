@@ -230,11 +230,13 @@ int dm_gp_set_terminal(dm_gp_session *s, const dm_gp_termreq *req,
 #define DM_GP_QUOTE_ONELINE 1  /* newlines become spaces (not "\n") */
 
 /* Write src[0..len) as a gnuplot string expression rendering exactly those
- * characters: single quotes; a quote becomes '."'".'; a newline (\n, \r\n,
- * \r) becomes '."\n".' (or a space with DM_GP_QUOTE_ONELINE); other control
- * characters become spaces.  Writes at most size bytes including the NUL
- * (dst may be NULL when size is 0) and returns the length the full result
- * needs, like snprintf. */
+ * characters: ordinary runs in single quotes, each of ' " \ ` @ and newline
+ * (\n, \r\n, \r) as an octal escape in a double-quoted piece ("\047"),
+ * joined with '.': no gnuplot scanner (lexer, macros, backticks) can misread
+ * it.  DM_GP_QUOTE_ONELINE turns newlines into spaces; other control
+ * characters always become spaces.  Writes at most size bytes including the
+ * NUL (dst may be NULL when size is 0) and returns the length the full
+ * result needs, like snprintf. */
 size_t dm_gp_quote(char *dst, size_t size, const char *src, size_t len,
                    int flags);
 
