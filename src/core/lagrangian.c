@@ -1,0 +1,582 @@
+/* lagrangian.c -- derive and compile a Lagrangian system; the dm_system
+ * callbacks that run the tapes (or their native versions).  See
+ * lagrangian.h. */
+#include <config.h>
+#include "lagrangian.h"
+#include "tape.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
+/* A compiled bundle of outputs: the tape and, when available, native code
+ * computing the same thing. */
+typedef struct prog {
+  dm_tape *tape;
+  dm_native *nat;
+  dm_native_fn fn;
+  size_t nout;
+} prog;
+
+typedef struct lag_data {
+  size_t n, m, npar;
+  char *name;
+  char **coords, **params;
+  double *par, *mass;
+  prog grad, all;             /* L, Lq, Lv | + Lvv, Lvq, Lqq */
+  prog force, force_all;      /* F | + Fq, Fv */
+  prog constr, constr_all;    /* g, G | + H */
+  prog massp;                 /* Lvv (n*n) when constant in q and v */
+  int mass_possible;
+} lag_data;
+
+static void prog_free(prog *p)
+{
+  dm_native_free(p->nat);
+  dm_tape_free(p->tape);
+  memset(p, 0, sizeof *p);
+}
+
+static void lag_free_data(lag_data *d)
+{
+  if (d == NULL)
+    return;
+  for (size_t i = 0; d->coords && i < d->n; i++)
+    free(d->coords[i]);
+  for (size_t i = 0; d->params && i < d->npar; i++)
+    free(d->params[i]);
+  free(d->coords);
+  free(d->params);
+  free(d->name);
+  free(d->par);
+  free(d->mass);
+  prog *ps[] = { &d->grad, &d->all, &d->force, &d->force_all, &d->constr,
+                 &d->constr_all, &d->massp };
+  for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    prog_free(ps[i]);
+  free(d);
+}
+
+static void lag_free(dm_system *s)
+{
+  lag_free_data(s->data);
+  s->data = NULL;
+}
+
+static inline void prog_run(const prog *p, const double *in, const double *par,
+                            double *out, double *tw)
+{
+  if (p->fn != NULL)
+    p->fn(in, par, out);
+  else
+    dm_tape_eval(p->tape, in, par, out, tw);
+}
+
+/* 1 if any of x[0..k) is NaN or infinite. */
+static int nonfinite(const double *x, size_t k)
+{
+  double s = 0;
+  for (size_t i = 0; i < k; i++)
+    s += x[i] * 0;          /* 0 unless some x[i] is NaN or Inf */
+  return isnan(s);
+}
+
+/* Copy a packed upper triangle into a full symmetric n*n matrix. */
+static const double *unpack_sym(const double *o, size_t n, double *M)
+{
+  for (size_t i = 0; i < n; i++)
+    for (size_t j = i; j < n; j++) {
+      M[i * n + j] = M[j * n + i] = *o++;
+    }
+  return o;
+}
+
+/* {==================================================================
+ * callbacks
+ * =================================================================== */
+
+static int lag_eval(void *data, const double *q, const double *v,
+                    const double *par, unsigned what, dm_lag_out *out,
+                    void *work)
+{
+  const lag_data *d = data;
+  size_t n = d->n;
+  double *in = work, *o = in + 2 * n;
+  const prog *p = (what & ~(unsigned)DM_LAG_GRAD) ? &d->all : &d->grad;
+  memcpy(in, q, n * sizeof *in);
+  memcpy(in + n, v, n * sizeof *in);
+  prog_run(p, in, par, o, o + p->nout);
+  if (nonfinite(o, p->nout))
+    return 1;               /* outside the domain: retry with another step */
+  if (what & DM_LAG_L)
+    out->L = o[0];
+  if (what & DM_LAG_Q)
+    memcpy(out->Lq, o + 1, n * sizeof *o);
+  if (what & DM_LAG_V)
+    memcpy(out->Lv, o + 1 + n, n * sizeof *o);
+  if (p == &d->all) {
+    const double *r = o + 1 + 2 * n;
+    size_t tri = n * (n + 1) / 2;
+    if (what & DM_LAG_VV)
+      unpack_sym(r, n, out->Lvv);
+    r += tri;
+    if (what & DM_LAG_VQ)
+      memcpy(out->Lvq, r, n * n * sizeof *r);
+    r += n * n;
+    if (what & DM_LAG_QQ)
+      unpack_sym(r, n, out->Lqq);
+  }
+  return 0;
+}
+
+static int force_eval(void *data, const double *q, const double *v,
+                      const double *par, unsigned what, double *F, double *Fq,
+                      double *Fv, void *work)
+{
+  const lag_data *d = data;
+  size_t n = d->n;
+  double *in = work, *o = in + 2 * n;
+  const prog *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  memcpy(in, q, n * sizeof *in);
+  memcpy(in + n, v, n * sizeof *in);
+  prog_run(p, in, par, o, o + p->nout);
+  if (nonfinite(o, p->nout))
+    return 1;
+  if (what & DM_FORCE_F)
+    memcpy(F, o, n * sizeof *o);
+  if (what & DM_FORCE_Q)
+    memcpy(Fq, o + n, n * n * sizeof *o);
+  if (what & DM_FORCE_V)
+    memcpy(Fv, o + n + n * n, n * n * sizeof *o);
+  return 0;
+}
+
+static int constr_eval(void *data, const double *q, const double *par,
+                       unsigned what, double *g, double *G, double *H,
+                       void *work)
+{
+  const lag_data *d = data;
+  size_t n = d->n, m = d->m;
+  double *o = work;
+  const prog *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
+  prog_run(p, q, par, o, o + p->nout);
+  if (nonfinite(o, p->nout))
+    return 1;
+  if (what & DM_CONSTR_G)
+    memcpy(g, o, m * sizeof *o);
+  if (what & DM_CONSTR_DG)
+    memcpy(G, o + m, m * n * sizeof *o);
+  if (what & DM_CONSTR_D2G) {
+    const double *r = o + m + m * n;
+    for (size_t a = 0; a < m; a++)
+      r = unpack_sym(r, n, H + a * n * n);
+  }
+  return 0;
+}
+
+/* {==================================================================
+ * building
+ * =================================================================== */
+
+typedef struct builder {
+  dm_expr_ctx *ctx;
+  const dm_lagrangian_spec *sp;
+  dm_expr *in;              /* q then v */
+  double *in0;              /* typical inputs, or NULL */
+  dm_err *err;
+} builder;
+
+static int ctx_fail(builder *b, const char *what)
+{
+  const dm_err *e = dm_expr_ctx_err(b->ctx);
+  return dm_err_set(b->err, e->status ? e->status : DM_EFAILED, "%s: %s",
+                    what, e->msg[0] ? e->msg : "cannot build the derivatives");
+}
+
+static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
+                        size_t nin)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  int s = dm_tape_compile(b->ctx, nout, out, nin, b->in, sp->npar, sp->par,
+                          &p->tape, b->err);
+  if (s != DM_OK)
+    return s;
+  p->nout = nout;
+  if (sp->native == DM_NATIVE_NEVER)
+    return DM_OK;
+  dm_err nerr;
+  s = dm_native_compile(p->tape, b->in0, sp->par_values, &p->nat, &nerr);
+  if (s == DM_OK)
+    p->fn = dm_native_function(p->nat);
+  else if (sp->native == DM_NATIVE_ALWAYS) {
+    if (b->err != NULL)
+      *b->err = nerr;
+    return s;
+  }
+  return DM_OK;             /* auto: the tape runs, silently */
+}
+
+/* Every symbol or parameter in e must be one of allowed[0..na). */
+static int check_vars(builder *b, dm_expr e, const char *what, size_t na,
+                      const dm_expr *allowed, const dm_expr *vel)
+{
+  dm_expr fv[64];
+  long k = dm_expr_free_vars(b->ctx, e, fv, 64);
+  if (k < 0)
+    return dm_err_set(b->err, DM_EINVAL, "%s is not a valid expression", what);
+  for (long i = 0; i < k && i < 64; i++) {
+    int ok = 0;
+    for (size_t j = 0; j < na && !ok; j++)
+      ok = allowed[j] == fv[i];
+    if (ok)
+      continue;
+    for (size_t j = 0; vel != NULL && j < b->sp->n; j++)
+      if (vel[j] == fv[i])
+        return dm_err_set(b->err, DM_EINVAL, "%s depends on the velocity "
+                          "'%s'", what, dm_expr_name(b->ctx, fv[i]));
+    return dm_err_set(b->err, DM_EINVAL, "%s depends on %s '%s', which is "
+                      "not a coordinate, velocity or parameter", what,
+                      dm_expr_kind(b->ctx, fv[i]) == DM_EXPR_SYM ? "symbol"
+                      : "parameter", dm_expr_name(b->ctx, fv[i]));
+  }
+  return DM_OK;
+}
+
+static char *dupstr(const char *s)
+{
+  return s ? strdup(s) : NULL;
+}
+
+static int copy_names(lag_data *d, const dm_lagrangian_spec *sp,
+                      dm_expr_ctx *ctx)
+{
+  d->coords = calloc(sp->n, sizeof *d->coords);
+  d->params = calloc(sp->npar ? sp->npar : 1, sizeof *d->params);
+  d->par = calloc(sp->npar ? sp->npar : 1, sizeof *d->par);
+  if (!d->coords || !d->params || !d->par)
+    return -1;
+  for (size_t i = 0; i < sp->n; i++)
+    if (!(d->coords[i] = dupstr(sp->coord_names ? sp->coord_names[i]
+                                : dm_expr_name(ctx, sp->q[i]))))
+      return -1;
+  for (size_t i = 0; i < sp->npar; i++) {
+    if (!(d->params[i] = dupstr(sp->param_names ? sp->param_names[i]
+                                : dm_expr_name(ctx, sp->par[i]))))
+      return -1;
+    d->par[i] = sp->par_values ? sp->par_values[i] : 0.0;
+  }
+  if (sp->name && !(d->name = strdup(sp->name)))
+    return -1;
+  return 0;
+}
+
+/* Evaluate the mass matrix at the current parameters and test positive
+ * definiteness (Cholesky).  Returns 1 when M is SPD. */
+static int eval_mass(lag_data *d)
+{
+  size_t n = d->n, nw = dm_tape_work_size(d->massp.tape);
+  double *buf = malloc((2 * n + n * n + nw) * sizeof *buf);
+  if (buf == NULL)
+    return 0;
+  memset(buf, 0, 2 * n * sizeof *buf);        /* q = v = 0: not read */
+  prog_run(&d->massp, buf, d->par, d->mass, buf + 2 * n + n * n);
+  memcpy(buf + 2 * n, d->mass, n * n * sizeof *buf);
+  gsl_matrix_view M = gsl_matrix_view_array(buf + 2 * n, n, n);
+  int spd = !nonfinite(d->mass, n * n) &&   /* needs dm_gsl_init() */
+            gsl_linalg_cholesky_decomp1(&M.matrix) == GSL_SUCCESS;
+  free(buf);
+  return spd;
+}
+
+/* Structure flags from the derived expressions; may compile the mass. */
+static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
+                            const dm_expr *Lvv, const dm_expr *Lvq,
+                            unsigned *flags)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n;
+  int mech = 1, constant = 1;
+  for (size_t i = 0; i < n * n; i++) {
+    mech &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->v);
+    constant &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->q);
+  }
+  *flags = mech ? DM_SYS_MECHANICAL : 0;
+  if (!mech || !constant)
+    return DM_OK;
+  double c;
+  for (size_t i = 0; i < n * n; i++)
+    if (!dm_expr_is_const(b->ctx, Lvq[i], &c) || c != 0)
+      return DM_OK;
+  /* Lv(q, 0) == 0: no term linear in v */
+  dm_expr *zero = malloc(n * sizeof *zero), *Lv0 = malloc(n * sizeof *Lv0);
+  int s = DM_ENOMEM, ok = 0;
+  if (zero && Lv0) {
+    for (size_t i = 0; i < n; i++)
+      zero[i] = dm_expr_const(b->ctx, 0.0);
+    s = dm_expr_subs(b->ctx, n, Lv, Lv0, n, sp->v, zero, b->err);
+    ok = s == DM_OK;
+    for (size_t i = 0; ok && i < n; i++)
+      ok = dm_expr_is_const(b->ctx, Lv0[i], &c) && c == 0;
+  }
+  free(zero);
+  free(Lv0);
+  if (s != DM_OK)
+    return s;
+  if (!ok)
+    return DM_OK;
+  d->mass = malloc(n * n * sizeof *d->mass);
+  if (d->mass == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  builder nb = *b;
+  dm_lagrangian_spec tsp = *sp;
+  tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
+  nb.sp = &tsp;
+  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n);
+  if (s != DM_OK)
+    return s;
+  d->mass_possible = 1;
+  if (eval_mass(d))
+    *flags |= DM_SYS_SEPARABLE;
+  return DM_OK;
+}
+
+/* L and its derivatives: tapes grad and all, and the structure flags. */
+static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, tri = n * (n + 1) / 2;
+  size_t nall = 1 + 2 * n + 2 * tri + n * n;
+  dm_expr *out = malloc(nall * sizeof *out);
+  dm_expr *Lvv = malloc(n * n * sizeof *Lvv), *Lvq = malloc(n * n * sizeof *Lvq);
+  int s = DM_ENOMEM;
+  if (!out || !Lvv || !Lvq) {
+    dm_err_set(b->err, s, "out of memory");
+    goto done;
+  }
+  dm_expr *Lq = out + 1, *Lv = out + 1 + n, *o = out + 1 + 2 * n;
+  out[0] = sp->L;
+  if (dm_expr_grad(b->ctx, sp->L, n, sp->q, Lq, NULL) != DM_OK ||
+      dm_expr_grad(b->ctx, sp->L, n, sp->v, Lv, NULL) != DM_OK) {
+    s = ctx_fail(b, "L");
+    goto done;
+  }
+  for (size_t i = 0; i < n; i++)            /* Lvv, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = Lvv[i * n + j] = Lvv[j * n + i] = dm_expr_diff(b->ctx, Lv[i], sp->v[j]);
+  for (size_t i = 0; i < n; i++)            /* Lvq, full */
+    for (size_t j = 0; j < n; j++)
+      *o++ = Lvq[i * n + j] = dm_expr_diff(b->ctx, Lv[i], sp->q[j]);
+  for (size_t i = 0; i < n; i++)            /* Lqq, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = dm_expr_diff(b->ctx, Lq[i], sp->q[j]);
+  if (dm_expr_ctx_err(b->ctx)->status != DM_OK) {
+    s = ctx_fail(b, "L");
+    goto done;
+  }
+  if ((s = compile_prog(b, &d->grad, 1 + 2 * n, out, 2 * n)) != DM_OK ||
+      (s = compile_prog(b, &d->all, nall, out, 2 * n)) != DM_OK)
+    goto done;
+  s = detect_structure(b, d, Lv, Lvv, Lvq, flags);
+done:
+  free(out);
+  free(Lvv);
+  free(Lvq);
+  return s;
+}
+
+static int build_force(builder *b, lag_data *d)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, nall = n + 2 * n * n;
+  dm_expr *out = malloc(nall * sizeof *out);
+  if (out == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  memcpy(out, sp->force, n * sizeof *out);
+  int s = DM_OK;
+  if (dm_expr_jacobian(b->ctx, n, sp->force, n, sp->q, out + n, NULL) != DM_OK ||
+      dm_expr_jacobian(b->ctx, n, sp->force, n, sp->v, out + n + n * n, NULL) != DM_OK)
+    s = ctx_fail(b, "force");
+  if (s == DM_OK)
+    s = compile_prog(b, &d->force, n, out, 2 * n);
+  if (s == DM_OK)
+    s = compile_prog(b, &d->force_all, nall, out, 2 * n);
+  free(out);
+  return s;
+}
+
+static int build_constraints(builder *b, lag_data *d)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, m = sp->m, tri = n * (n + 1) / 2;
+  size_t nall = m + m * n + m * tri;
+  dm_expr *out = malloc(nall * sizeof *out);
+  if (out == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  memcpy(out, sp->constraints, m * sizeof *out);
+  dm_expr *G = out + m, *o = out + m + m * n;
+  int s = DM_OK;
+  if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)
+    s = ctx_fail(b, "constraints");
+  for (size_t a = 0; s == DM_OK && a < m; a++)
+    for (size_t i = 0; i < n; i++)
+      for (size_t j = i; j < n; j++)
+        *o++ = dm_expr_diff(b->ctx, G[a * n + i], sp->q[j]);
+  if (s == DM_OK && dm_expr_ctx_err(b->ctx)->status != DM_OK)
+    s = ctx_fail(b, "constraints");
+  if (s == DM_OK)
+    s = compile_prog(b, &d->constr, m + m * n, out, n);
+  if (s == DM_OK)
+    s = compile_prog(b, &d->constr_all, nall, out, n);
+  free(out);
+  return s;
+}
+
+static int check_spec(builder *b)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, na = 2 * n + sp->npar;
+  char what[64];
+  if (n == 0 || !sp->q || !sp->v || (sp->npar && !sp->par) ||
+      (sp->m && !sp->constraints))
+    return dm_err_set(b->err, DM_EINVAL, "a system needs n >= 1 coordinates, "
+                      "their velocities and the listed parameters");
+  for (size_t i = 0; i < 2 * n; i++)
+    if (dm_expr_kind(b->ctx, b->in[i]) != DM_EXPR_SYM)
+      return dm_err_set(b->err, DM_EINVAL, "%s %zu is not a symbol",
+                        i < n ? "coordinate" : "velocity", i % n + 1);
+  for (size_t i = 0; i < 2 * n; i++)
+    for (size_t j = 0; j < i; j++)
+      if (b->in[i] == b->in[j])
+        return dm_err_set(b->err, DM_EINVAL, "'%s' is listed twice among the "
+                          "coordinates and velocities",
+                          dm_expr_name(b->ctx, b->in[i]));
+  dm_expr *allowed = malloc(na * sizeof *allowed);
+  if (allowed == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  memcpy(allowed, b->in, 2 * n * sizeof *allowed);
+  if (sp->npar)
+    memcpy(allowed + 2 * n, sp->par, sp->npar * sizeof *allowed);
+  int s = check_vars(b, sp->L, "L", na, allowed, NULL);
+  for (size_t i = 0; s == DM_OK && sp->force && i < n; i++) {
+    snprintf(what, sizeof what, "force component %zu", i + 1);
+    s = check_vars(b, sp->force[i], what, na, allowed, NULL);
+  }
+  /* constraints: coordinates and parameters only */
+  memmove(allowed + n, allowed + 2 * n, sp->npar * sizeof *allowed);
+  for (size_t a = 0; s == DM_OK && a < sp->m; a++) {
+    snprintf(what, sizeof what, "constraint %zu", a + 1);
+    s = check_vars(b, sp->constraints[a], what, n + sp->npar, allowed, sp->v);
+  }
+  free(allowed);
+  return s;
+}
+
+static size_t prog_need(const prog *p)
+{
+  return p->tape ? p->nout + dm_tape_work_size(p->tape) : 0;
+}
+
+int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
+                          dm_system *sys, dm_err *err)
+{
+  memset(sys, 0, sizeof *sys);
+  size_t n = sp->n;
+  builder b = { ctx, sp, NULL, NULL, err };
+  lag_data *d = calloc(1, sizeof *d);
+  b.in = malloc((2 * n + 1) * sizeof *b.in);
+  if (sp->q0 && sp->v0)
+    b.in0 = malloc((2 * n + 1) * sizeof *b.in0);
+  int s = DM_ENOMEM;
+  if (d == NULL || b.in == NULL || (sp->q0 && sp->v0 && b.in0 == NULL)) {
+    dm_err_set(err, s, "out of memory");
+    goto fail;
+  }
+  if (n) {
+    memcpy(b.in, sp->q, n * sizeof *b.in);
+    memcpy(b.in + n, sp->v, n * sizeof *b.in);
+  }
+  if (b.in0) {
+    memcpy(b.in0, sp->q0, n * sizeof *b.in0);
+    memcpy(b.in0 + n, sp->v0, n * sizeof *b.in0);
+  }
+  d->n = n;
+  d->m = sp->m;
+  d->npar = sp->npar;
+  if ((s = check_spec(&b)) != DM_OK)
+    goto fail;
+  if (copy_names(d, sp, ctx) != 0) {
+    s = dm_err_set(err, DM_ENOMEM, "out of memory");
+    goto fail;
+  }
+  unsigned flags = 0;
+  if ((s = build_lagrangian(&b, d, &flags)) != DM_OK ||
+      (sp->force && (s = build_force(&b, d)) != DM_OK) ||
+      (sp->m && (s = build_constraints(&b, d)) != DM_OK))
+    goto fail;
+
+  size_t need = 0;
+  const prog *ps[] = { &d->grad, &d->all, &d->force, &d->force_all,
+                       &d->constr, &d->constr_all };
+  for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    if (prog_need(ps[i]) > need)
+      need = prog_need(ps[i]);
+  sys->name = d->name;
+  sys->n = n;
+  sys->npar = sp->npar;
+  sys->m = sp->m;
+  sys->coords = (const char *const *)d->coords;
+  sys->params = (const char *const *)d->params;
+  sys->par = d->par;
+  sys->flags = flags;
+  sys->mass = (flags & DM_SYS_SEPARABLE) ? d->mass : NULL;
+  sys->lagrangian = lag_eval;
+  sys->force = sp->force ? force_eval : NULL;
+  sys->constraints = sp->m ? constr_eval : NULL;
+  sys->data = d;
+  sys->work_size = (2 * n + need) * sizeof(double);
+  sys->free_data = lag_free;
+  free(b.in);
+  free(b.in0);
+  return DM_OK;
+fail:
+  lag_free_data(d);
+  free(b.in);
+  free(b.in0);
+  memset(sys, 0, sizeof *sys);
+  return s;
+}
+
+int dm_lagrangian_refresh(dm_system *sys, dm_err *err)
+{
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return dm_err_set(err, DM_EINVAL, "not a system compiled from a Lagrangian");
+  lag_data *d = sys->data;
+  if (!d->mass_possible)
+    return DM_OK;
+  if (eval_mass(d)) {
+    sys->flags |= DM_SYS_SEPARABLE;
+    sys->mass = d->mass;
+  } else {
+    sys->flags &= ~(unsigned)DM_SYS_SEPARABLE;
+    sys->mass = NULL;
+  }
+  return DM_OK;
+}
+
+int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st)
+{
+  memset(st, 0, sizeof *st);
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return DM_EINVAL;
+  const lag_data *d = sys->data;
+  st->ninstr_grad = dm_tape_ninstr(d->grad.tape);
+  st->ninstr_all = dm_tape_ninstr(d->all.tape);
+  st->nregs_all = dm_tape_nregs(d->all.tape);
+  st->native_grad = d->grad.fn != NULL;
+  st->native_all = d->all.fn != NULL;
+  st->ninstr_force = d->force_all.tape ? dm_tape_ninstr(d->force_all.tape) : 0;
+  st->ninstr_constr = d->constr_all.tape ? dm_tape_ninstr(d->constr_all.tape) : 0;
+  return DM_OK;
+}

@@ -1,0 +1,66 @@
+/* native.h -- tapes compiled to machine code by the system C compiler.
+ *
+ * dm_native_compile emits straight-line C for a tape (one local double per
+ * instruction, the same operations in the same order, so results agree with
+ * the tape to the last bit in practice), compiles it with $CC (else "cc")
+ * `-O2 -fPIC -shared -ffp-contract=off` in a private mkdtemp directory
+ * (mode 0700) under $TMPDIR (else /tmp), loads it with dlopen and checks it
+ * against the tape on random points (relative agreement 1e-15, NaN equal to
+ * NaN).  Objects are cached under $XDG_CACHE_HOME/dmech (else
+ * ~/.cache/dmech; directory 0700, files 0600, written to a temporary name
+ * and renamed) keyed by the SHA-256 of the emitted source, the compiler
+ * command and its --version text; a cached object is loaded only when it is
+ * a regular file owned by the user and not writable by others.  The
+ * compiler runs through posix_spawn (never a shell); its stderr becomes the
+ * error message.
+ *
+ * Errors (the caller then uses the tape): DM_ENOTFOUND no compiler,
+ * DM_EFAILED compilation failed or the code disagrees with the tape,
+ * DM_EIO file or dlopen trouble, DM_EINTR interrupted, DM_ETIMEOUT the
+ * compiler ran longer than 300 s.  Nothing is printed.
+ *
+ * Ownership: dm_native_compile allocates, dm_native_free releases (NULL
+ * ok); the loaded code stays valid until then and does not refer to the
+ * tape.  The compiled function is re-entrant (no work buffer needed).
+ */
+#ifndef DM_NATIVE_H
+#define DM_NATIVE_H
+
+#include <stddef.h>
+
+#include "status.h"
+#include "tape.h"
+
+/* What the caller wants (dm.config.native). */
+enum dm_native_mode {
+  DM_NATIVE_NEVER = 0,  /* always the tape */
+  DM_NATIVE_AUTO,       /* native when a compiler works, else the tape, silently */
+  DM_NATIVE_ALWAYS      /* native or an error */
+};
+
+typedef struct dm_native dm_native;
+
+/* out[nout] = outputs at (in, par), same contract as dm_tape_eval. */
+typedef void (*dm_native_fn)(const double *in, const double *par, double *out);
+
+/* Compile tape t.  in0 / par0 (may be NULL) are a typical point: the check
+ * against the tape uses points near it as well as random ones. */
+int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
+                      dm_native **nat, dm_err *err);
+void dm_native_free(dm_native *nat);
+
+dm_native_fn dm_native_function(const dm_native *nat);
+/* 1 if the object came from the cache, 0 if it was compiled now. */
+int dm_native_cached(const dm_native *nat);
+/* The cache key (64 hex digits). */
+const char *dm_native_key(const dm_native *nat);
+
+/* The C source emitted for t (malloc'ed, caller frees; NULL when out of
+ * memory). */
+char *dm_native_source(const dm_tape *t);
+
+/* "never" / "auto" / "always" and back (-1 for an unknown name). */
+const char *dm_native_mode_name(int mode);
+int dm_native_mode_parse(const char *name);
+
+#endif
