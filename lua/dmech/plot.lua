@@ -110,7 +110,7 @@ local function tovec(what, where, col, name)
   if next(col) == nil then return EMPTY end
   local ok, v = pcall(core.vec, col)
   if not ok then
-    fail(what, "%s%s: %s", where, name, (tostring(v):gsub("^bad argument #1 to 'vec' ", "")))
+    fail(what, "%s%s: %s", where, name, (tostring(v):gsub("^bad argument #%d+ to '[^']*' ", "")))
   end
   return v
 end
@@ -431,6 +431,10 @@ local function draw(what, opts, panels, layout, target)
   end
   local total = 0
   for _, b in ipairs(blocks) do total = total + b.n end
+  if total == 0 then
+    if target.need_points then fail(what, "nothing to plot (every series is empty)") end
+    return nil, 0
+  end
   gp.begin(what)
   if #M.garbage > 0 then
     local names = {}
@@ -463,8 +467,9 @@ local function draw(what, opts, panels, layout, target)
     io.stdout:write(out)
     io.stdout:flush()
   end
-  if msgs:find("%S") then
-    io.stderr:write((msgs:gsub("^%s+", ""):gsub("%s+$", "")), "\n")
+  for line in msgs:gmatch("[^\n]+") do        -- warnings, not errors
+    line = line:gsub("^%s*line %d+: ", ""):gsub("^warning: ", "")
+    if line:find("%S") then io.stderr:write(what, ": gnuplot: ", line, "\n") end
   end
   return term, total
 end
@@ -504,7 +509,7 @@ function M.plot(spec)
   local nblocks = 0
   for _, p in ipairs(panels) do nblocks = nblocks + #p.series end
   draw(what, spec, panels, layout, {file = spec.output, terminal = spec.terminal,
-    size = spec.size, window = 0, prefix = "dmp_",
+    size = spec.size, window = 0, prefix = "dmp_", need_points = true,
     after = function(n)
       -- forget the blocks of a bigger previous plot
       if plot_blocks > n then
@@ -551,7 +556,7 @@ local function fig_draw(f, what, target)
                        window = f.id}
   t.prefix = "dmf" .. f.id .. "_"
   local term = draw(what, f.opts, f.panels, f.layout, t)
-  if target == nil then f.term = term end
+  if target == nil and term then f.term = term end
 end
 
 -- Set options and series from a spec table (used by dm.figure and :plot).

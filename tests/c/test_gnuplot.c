@@ -496,7 +496,7 @@ static void test_big_data(dm_gp_session *s, size_t n)
     FILE *f;
     int left = -1;
     snprintf(cmd, sizeof cmd, "ls %s/dmech-gnuplot-*/ 2>/dev/null | grep -c dat",
-             getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+             tmpdir);
     if ((f = popen(cmd, "r")) != NULL) {
       if (fgets(line, sizeof line, f) != NULL)
         left = atoi(line);
@@ -704,6 +704,7 @@ int main(void)
       return 1;
   }
   unsetenv("DMECH_GNUPLOT_LOG");
+  setenv("TMPDIR", tmpdir, 1);      /* the private data directories go here */
   test_quote_table();
   test_pick_terminal();
 
