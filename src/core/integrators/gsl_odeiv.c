@@ -2,9 +2,12 @@
  * method "gsl:<stepper>" (rk2, rk4, rkf45, rkck, rk8pd, rk1imp, rk2imp,
  * rk4imp, bsimp, msadams, msbdf) on the Hamiltonian form y = (q, p),
  * ydot = (v(q, p), Lq + F), with the exact Jacobian for the implicit ones.
- * Fixed steps use gsl_odeiv2_driver_apply_fixed_step (one call per h);
- * option adaptive = true integrates each h with gsl_odeiv2_driver_apply and
- * the tolerances epsabs, epsrel.  Note (spec T2.7): rk4imp with a fixed step
+ * Fixed steps call gsl_odeiv2_step_apply directly (the driver's
+ * apply_fixed_step would reject steps whose error estimate exceeds the
+ * tolerances); the stepper stays attached to a driver, whose tolerances
+ * epsabs/epsrel the implicit and multistep steppers use internally.
+ * Option adaptive = true integrates each h with gsl_odeiv2_driver_apply;
+ * the multistep msadams and msbdf require it.  Note (spec T2.7): rk4imp with a fixed step
  * h takes two Gauss-2 steps of h/2 (step doubling); its internal Newton
  * uses the driver tolerances.  The step Jacobian is not available in closed
  * form (finite differences are used by the diagnostics). */
@@ -32,8 +35,8 @@ typedef struct gsl_state {
   dm_integrator *I;
   gsl_odeiv2_system sys;
   gsl_odeiv2_driver *d;
-  double *y, *hq1, *hp1;
-  double last_h;
+  double *y, *yerr, *hq1, *hp1;
+  double last_h, t;
   int hist;
   dm_err err;
 } gsl_state;
@@ -83,13 +86,17 @@ static int gsl_alloc(dm_integrator *I, dm_err *e)
     return dm_err_set(e, DM_ENOTFOUND, "unknown GSL stepper '%s' in method '%s' (known: rk2, rk4, "
                       "rkf45, rkck, rk8pd, rk1imp, rk2imp, rk4imp, bsimp, msadams, msbdf)",
                       I->variant, I->name);
-  if ((S = calloc(1, sizeof *S)) == NULL || (S->y = calloc(4 * n, sizeof(double))) == NULL) {
+  if (!I->opt.adaptive && (T == gsl_odeiv2_step_msadams || T == gsl_odeiv2_step_msbdf))
+    return dm_err_set(e, DM_EINVAL, "%s is a variable-order multistep method driven by its error "
+                      "control: use it with adaptive = true", I->name);
+  if ((S = calloc(1, sizeof *S)) == NULL || (S->y = calloc(6 * n, sizeof(double))) == NULL) {
     free(S);
     return dm_err_set(e, DM_ENOMEM, "gsl: out of memory");
   }
   I->state = S;
   S->I = I;
-  S->hq1 = S->y + 2 * n;
+  S->yerr = S->y + 2 * n;
+  S->hq1 = S->yerr + 2 * n;
   S->hp1 = S->hq1 + n;
   S->sys.function = rhs;
   S->sys.jacobian = jac;
@@ -116,12 +123,19 @@ static int gsl_step(dm_integrator *I, double h, const double *q0, const double *
              && memcmp(p0, S->hp1, n * sizeof(double)) == 0 && h == S->last_h;
   memcpy(S->y, q0, n * sizeof(double));
   memcpy(S->y + n, p0, n * sizeof(double));
-  if (!cont)
+  if (!cont) {
     gsl_odeiv2_driver_reset_hstart(S->d, h);
+    S->t = 0.0;
+  }
+  t = S->t;
   dm_err_clear(&S->err);
   S->hist = 0;
-  gs = I->opt.adaptive ? gsl_odeiv2_driver_apply(S->d, &t, h, S->y)
-                       : gsl_odeiv2_driver_apply_fixed_step(S->d, &t, h, 1, S->y);
+  if (I->opt.adaptive) {
+    gs = gsl_odeiv2_driver_apply(S->d, &t, S->t + h, S->y);
+  } else {
+    gs = gsl_odeiv2_step_apply(S->d->s, t, h, S->y, S->yerr, NULL, NULL, &S->sys);
+    t += h;
+  }
   if (gs != GSL_SUCCESS) {
     if (S->err.status != DM_OK)
       return dm_err_set(e, S->err.status, "%s", S->err.msg);
@@ -134,6 +148,7 @@ static int gsl_step(dm_integrator *I, double h, const double *q0, const double *
   memcpy(S->hq1, S->y, n * sizeof(double));
   memcpy(S->hp1, S->y + n, n * sizeof(double));
   S->last_h = h;
+  S->t = t;
   S->hist = 1;
   I->stats.steps++;
   return DM_OK;

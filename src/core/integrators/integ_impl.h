@@ -18,9 +18,19 @@
 #include "integrator.h"
 
 /* Newton iterations stop at the tolerance, or, once the scaled update is
- * below this bound, when two consecutive updates fail to halve (round-off
- * floor of an ill-conditioned system). */
+ * below DM_NEWTON_ACCEPT, when two updates failed to halve the best update
+ * so far (the round-off floor of an ill-conditioned system, where updates
+ * bounce around 1e-14 instead of decreasing). */
 #define DM_NEWTON_ACCEPT 1e-10
+
+static inline int dm_newton_stalled(double d, double *best, int *stall)
+{
+  if (d <= DM_NEWTON_ACCEPT && d > 0.5 * *best)
+    (*stall)++;
+  if (d < *best)
+    *best = d;
+  return *stall >= 2;
+}
 
 /* {==== checked evaluation ============================================== */
 

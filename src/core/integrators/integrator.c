@@ -322,8 +322,8 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
       break;
     }
     if ((st = dm_integrator_step(I, h, q, p, q1, p1, &le)) != DM_OK) {
-      dm_err_set(e, st, "step %ld of %ld from t = %.17g failed (residual %.3g, tolerance %.3g): %s",
-                 k, nsteps, t0 + (double)(k - 1) * h, I->stats.residual, I->stats.tol, le.msg);
+      dm_err_set(e, st, "step %ld of %ld from t = %.17g failed: %s", k, nsteps,
+                 t0 + (double)(k - 1) * h, le.msg);
       break;
     }
     memcpy(q, q1, n * sizeof(double));

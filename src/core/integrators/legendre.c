@@ -125,10 +125,8 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
       return dm_err_set(e, DM_EDOM, "velocity solve produced a non-finite value");
     if (mech || d <= w->tol)
       return DM_OK;
-    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
-    if (stall >= 2)
+    if (dm_newton_stalled(d, &dprev, &stall))
       return DM_OK;
-    dprev = d;
   }
   return dm_err_set(e, DM_ENOCONV,
                     "velocity from momentum (Newton on dL/dv = p) did not converge: "

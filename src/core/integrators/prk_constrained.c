@@ -226,10 +226,8 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
              dm_norm_inf(P->R + n, m) / fmax(fmax(dm_norm_inf(mu, m), ps), DBL_MIN));
     if (mech || d <= P->tol)
       break;
-    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
-    if (stall >= 2)
+    if (dm_newton_stalled(d, &dprev, &stall))
       break;
-    dprev = d;
   }
   if (it == P->maxiter)
     return dm_err_set(e, DM_ENOCONV, "momentum projection did not converge (update %.3g)", d);

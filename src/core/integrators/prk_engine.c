@@ -11,7 +11,7 @@
  * factored with GSL LU, and iterates to round-off: stop when the scaled
  * update is <= tol (default 10 eps), or, once the update is below
  * DM_NEWTON_ACCEPT = 1e-10 (round-off regime of an ill-conditioned system),
- * after two consecutive updates that did not halve; at most maxiter
+ * after two updates that did not halve the best one; at most maxiter
  * iterations (failure: DM_ENOCONV with the update, residual and tolerance).
  * The predictor extrapolates the previous step's stage-velocity polynomial
  * (nodes c, values V) to the new stage times; without history (or with
@@ -317,12 +317,10 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
       break;
     }
     /* in the round-off regime, stop once the updates stop contracting */
-    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
-    if (stall >= 2) {
+    if (dm_newton_stalled(d, &dprev, &stall)) {
       ok = 1;
       break;
     }
-    dprev = d;
   }
   if (it > P->maxiter)
     it = P->maxiter;

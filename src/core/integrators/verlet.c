@@ -104,10 +104,8 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
     d = dm_norm_inf(P->R, m) / fmax(fmax(dm_norm_inf(mu, m), ms), DBL_MIN);
     if (d <= P->tol)
       break;
-    stall = (d <= DM_NEWTON_ACCEPT && d > 0.5 * dprev) ? stall + 1 : 0;
-    if (stall >= 2)
+    if (dm_newton_stalled(d, &dprev, &stall))
       break;
-    dprev = d;
   }
   if (stt) {
     stt->iters = it > P->maxiter ? P->maxiter : it;

@@ -1,0 +1,231 @@
+/* test_integrators_run.c -- the run loop (sampling, interrupt, Newton
+ * failure keeps the partial trajectory, sink stop), error paths (singular
+ * Hessian, NaN state, domain errors, unknown method, stages out of range),
+ * the option table and the registry. */
+#include <config.h>
+#include <math.h>
+#include <string.h>
+#include "core/status.h"
+#include "core/interrupt.h"
+#include "core/builtin_systems.h"
+#include "core/integrators/integrator.h"
+#include "integ_testsys.h"
+#include "tap.h"
+
+typedef struct rec {
+  long n, stop_after, interrupt_after;
+  double t[64], q[64], p[64], v[64];
+} rec;
+
+static int record(void *ctx, double t, const double *q, const double *p, const double *v)
+{
+  rec *r = ctx;
+  if (r->n < 64) {
+    r->t[r->n] = t;
+    r->q[r->n] = q[0];
+    r->p[r->n] = p[0];
+    r->v[r->n] = v[0];
+  }
+  r->n++;
+  if (r->interrupt_after && r->n == r->interrupt_after)
+    dm_interrupt_raise();
+  if (r->stop_after && r->n == r->stop_after)
+    return DM_ENOMEM;          /* what dm_traj_sink returns when storage fails */
+  return 0;
+}
+
+static void sampling(void)
+{
+  dm_system s;
+  dm_integrator *I = NULL;
+  rec r;
+  dm_run_info info;
+  double q = 1.0, p = 0.5, qq = 1.0, pp = 0.5;
+  int st, k;
+  dm_err e;
+  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_integrator_new(&s, "gauss", NULL, &I, NULL);
+  memset(&r, 0, sizeof r);
+  st = dm_integrator_run(I, 2.385, &q, &p, 0.1, 10, 3, record, &r, &info, &e);
+  tap_ok(st == DM_OK && r.n == 5 && info.samples == 5 && info.steps == 10,
+         "10 steps every 3: samples at steps 0, 3, 6, 9, 10 (%ld samples)", r.n);
+  tap_ok(r.t[0] == 2.385 && fabs(r.t[1] - 2.685) < 1e-15 && fabs(r.t[4] - 3.385) < 1e-15 && fabs(info.t - 3.385) < 1e-15,
+         "sample times t0 + k h (%.17g, %.17g)", r.t[1], r.t[4]);
+  tap_ok(fabs(r.v[2] - r.p[2]) < 1e-15, "sampled velocity v(q, p) (= p for the pendulum)");
+  for (k = 0; k < 10; k++)
+    dm_integrator_step(I, 0.1, &qq, &pp, &qq, &pp, NULL);
+  tap_ok(q == qq && p == pp && r.q[4] == q, "run state = 10 single steps (bitwise)");
+  dm_integrator_free(I);
+  dm_system_release(&s);
+}
+
+static void stops(void)
+{
+  dm_system s, kep;
+  dm_integrator *I = NULL;
+  rec r;
+  dm_run_info info;
+  double q = 1.0, p = 0.5;
+  int st;
+  dm_err e;
+  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_integrator_new(&s, "lobatto", NULL, &I, NULL);
+  /* Ctrl-C: the flag raised from inside the run stops it before the next step */
+  memset(&r, 0, sizeof r);
+  r.interrupt_after = 3;
+  dm_interrupt_clear();
+  st = dm_integrator_run(I, 0.0, &q, &p, 0.1, 100, 2, record, &r, &info, &e);
+  tap_ok(st == DM_EINTR && info.steps == 4 && r.n == 3 && fabs(info.t - 0.4) < 1e-15,
+         "interrupt: DM_EINTR after step %ld (t = %g), %ld samples kept", info.steps, info.t, r.n);
+  tap_ok(strstr(e.msg, "interrupted after step 4 of 100") != NULL, "message: %s", e.msg);
+  dm_interrupt_clear();
+  /* the sink refuses (out of memory): stop, keep the samples */
+  memset(&r, 0, sizeof r);
+  r.stop_after = 4;
+  q = 1.0;
+  p = 0.5;
+  st = dm_integrator_run(I, 0.0, &q, &p, 0.1, 100, 1, record, &r, &info, &e);
+  tap_ok(st == DM_ENOMEM && info.steps == 3 && r.n == 4, "sink failure stops the run (%s) after step %ld",
+         dm_strstatus(st), info.steps);
+  dm_integrator_free(I);
+
+  /* Newton failure at a huge step (Kepler from apocentre, h = 1): the steps
+   * before the failure and the last good state are kept */
+  dm_builtin_kepler(&kep, 2, 1.0, NULL);
+  dm_integrator_new(&kep, "gauss", NULL, &I, NULL);
+  {
+    double qk[2] = {-1.6, 0.0}, pk[2] = {0.0, -0.5}, q3[2], p3[2];
+    memset(&r, 0, sizeof r);
+    st = dm_integrator_run(I, 0.0, qk, pk, 1.0, 20, 1, record, &r, &info, &e);
+    tap_ok(st == DM_ENOCONV && info.steps == 3 && r.n == 4 && info.t == 3.0,
+           "Newton failure at h = 1: DM_ENOCONV after %ld steps, %ld samples kept", info.steps, r.n);
+    tap_ok(strstr(e.msg, "step 4 of 20") && strstr(e.msg, "t = 3") && strstr(e.msg, "residual")
+           && strstr(e.msg, "tol"), "message names step, time, residual, tolerance: %s", e.msg);
+    tap_ok(info.residual > info.tol && info.tol > 0, "run info: update %.3g > tol %.3g", info.residual, info.tol);
+    memcpy(q3, qk, sizeof q3);
+    memcpy(p3, pk, sizeof p3);
+    tap_ok(isfinite(q3[0]) && r.q[3] == q3[0], "q, p hold the last good state (the last sample)");
+  }
+  dm_integrator_free(I);
+  dm_system_release(&kep);
+  dm_system_release(&s);
+}
+
+static void errors(void)
+{
+  dm_system s, sing, kep;
+  dm_integrator *I = (dm_integrator *)1;
+  dm_integ_opts o;
+  dm_err e;
+  dm_run_info info;
+  double q = NAN, p = 0.5, q2[2] = {0.3, 0.2}, p2[2] = {0.1, 0.1}, v2[2];
+  int st;
+  dm_builtin_pendulum(&s, 1.0, NULL);
+  tap_is_int(dm_integrator_new(&s, "leapfrog9", NULL, &I, &e), DM_ENOTFOUND, "unknown method rejected");
+  tap_ok(I == NULL && strstr(e.msg, "leapfrog9") && strstr(e.msg, "gauss") && strstr(e.msg, "gsl:<stepper>"),
+         "message lists the methods: %s", e.msg);
+  dm_integ_opts_init(&o);
+  o.stages = 21;
+  tap_is_int(dm_integrator_new(&s, "gauss", &o, &I, &e), DM_EINVAL, "gauss stages = 21: %s", e.msg);
+  tap_ok(strstr(e.msg, "out of range") != NULL, "message says out of range");
+  o.stages = 1;
+  tap_is_int(dm_integrator_new(&s, "lobatto", &o, &I, &e), DM_EINVAL, "lobatto stages = 1: %s", e.msg);
+  o.stages = 2;
+  tap_is_int(dm_integrator_new(&s, "midpoint", &o, &I, &e), DM_EINVAL, "midpoint stages = 2: %s", e.msg);
+  o.stages = -3;
+  tap_is_int(dm_integrator_new(&s, "gauss", &o, &I, &e), DM_EINVAL, "gauss stages = -3 rejected");
+  dm_integ_opts_init(&o);
+  o.tol = 0.0;
+  tap_is_int(dm_integrator_new(&s, "gauss", &o, &I, &e), DM_EINVAL, "tol = 0 rejected: %s", e.msg);
+
+  /* NaN state */
+  dm_integrator_new(&s, "gauss", NULL, &I, NULL);
+  st = dm_integrator_run(I, 0.0, &q, &p, 0.1, 10, 1, NULL, NULL, &info, &e);
+  tap_ok(st == DM_EDOM && strstr(e.msg, "NaN"), "NaN initial state: %s", e.msg);
+  q = 1.0;
+  st = dm_integrator_run(I, 0.0, &q, &p, 0.0, 10, 1, NULL, NULL, &info, &e);
+  tap_ok(st == DM_EINVAL, "h = 0 rejected by run: %s", e.msg);
+  st = dm_integrator_step(I, INFINITY, &q, &p, &q, &p, &e);
+  tap_ok(st == DM_EINVAL, "infinite h rejected by step");
+  p = 1e300;
+  st = dm_integrator_step(I, 1e10, &q, &p, &q, &p, &e);
+  tap_ok(st != DM_OK, "overflowing step reported (%s: %s)", dm_strstatus(st), e.msg);
+  dm_integrator_free(I);
+
+  /* singular Hessian d2L/dv2 */
+  ts_singular(&sing);
+  dm_integrator_new(&sing, "gauss", NULL, &I, NULL);
+  st = dm_integrator_step(I, 0.1, q2, p2, q2, p2, &e);
+  tap_ok(st == DM_ESINGULAR && strstr(e.msg, "not regular") && strstr(e.msg, "d2L/dv2"),
+         "singular Hessian, Gauss step: %s", e.msg);
+  st = dm_integrator_velocity(I, q2, p2, v2, 0, &e);
+  tap_ok(st == DM_ESINGULAR && strstr(e.msg, "not regular"), "singular Hessian, velocity: %s", e.msg);
+  dm_integrator_free(I);
+  dm_integrator_new(&sing, "rk4", NULL, &I, NULL);
+  st = dm_integrator_step(I, 0.1, q2, p2, q2, p2, &e);
+  tap_ok(st == DM_ESINGULAR, "singular Hessian, rk4 step: DM_ESINGULAR");
+  dm_integrator_free(I);
+
+  /* a callback outside its domain: Kepler at the origin */
+  dm_builtin_kepler(&kep, 2, 1.0, NULL);
+  dm_integrator_new(&kep, "trapezoid", NULL, &I, NULL);
+  q2[0] = q2[1] = 0.0;
+  st = dm_integrator_step(I, 0.1, q2, p2, q2, p2, &e);
+  tap_ok(st == DM_EDOM && strstr(e.msg, "outside the domain"), "Kepler at the origin: %s", e.msg);
+  dm_integrator_free(I);
+  dm_system_release(&kep);
+  dm_system_release(&s);
+}
+
+static void options_and_registry(void)
+{
+  dm_integ_opts o;
+  dm_err e;
+  double v = 0;
+  const char *str = NULL, *variant = NULL;
+  const dm_integrator_type *const *t;
+  const dm_integrator_type *g;
+  int all = 1;
+  dm_integ_opts_init(&o);
+  tap_is_int(dm_integ_opts_set_number(&o, "stages", 3, &e), DM_OK, "set stages = 3");
+  tap_is_int(o.stages, 3, "stages field written through the descriptor");
+  tap_is_int(dm_integ_opts_set_number(&o, "stages", 2.5, &e), DM_EINVAL, "stages = 2.5: %s", e.msg);
+  tap_is_int(dm_integ_opts_set_number(&o, "tol", 1e-20, &e), DM_EINVAL, "tol = 1e-20 below eps: %s", e.msg);
+  tap_is_int(dm_integ_opts_set_number(&o, "tol", 2.385e-12, &e), DM_OK, "tol = 2.385e-12");
+  dm_integ_opts_get(&o, "tol", &v, NULL, NULL);
+  tap_ok(v == 2.385e-12, "get tol");
+  tap_is_int(dm_integ_opts_set_number(&o, "explicit", 0, &e), DM_OK, "explicit = false");
+  tap_is_int(o.explicit_sv, 0, "explicit field");
+  tap_is_int(dm_integ_opts_set_string(&o, "scheme", "kahanli8", &e), DM_OK, "scheme = kahanli8");
+  dm_integ_opts_get(&o, "scheme", NULL, &str, NULL);
+  tap_ok(str && strcmp(str, "kahanli8") == 0, "get scheme");
+  tap_is_int(dm_integ_opts_set_string(&o, "stages", "two", &e), DM_EINVAL, "string for a number: %s", e.msg);
+  tap_is_int(dm_integ_opts_set_number(&o, "scheme", 1, &e), DM_EINVAL, "number for a string");
+  tap_is_int(dm_integ_opts_set_number(&o, "stepsize", 1, &e), DM_ENOTFOUND, "unknown option: %s", e.msg);
+  g = dm_integrator_lookup("gsl:rk8pd", &variant);
+  tap_ok(g && strcmp(g->name, "gsl") == 0 && variant && strcmp(variant, "rk8pd") == 0,
+         "lookup gsl:rk8pd -> type gsl, variant rk8pd");
+  tap_ok(dm_integrator_lookup("gaus", NULL) == NULL && dm_integrator_lookup("gausss", NULL) == NULL,
+         "lookup needs the exact family name");
+  for (t = dm_integrator_types(); *t; t++) {
+    const char *const *on;
+    if (!(*t)->name || !(*t)->summary || !(*t)->alloc || !(*t)->step || !(*t)->free)
+      all = 0;
+    for (on = (*t)->options; on && *on; on++)
+      if (dm_integ_option_find(*on) == NULL && strcmp(*on, "tableau") != 0) {
+        tap_diag("%s lists unknown option %s", (*t)->name, *on);
+        all = 0;
+      }
+  }
+  tap_ok(all, "every registered type is complete and lists only known options");
+}
+
+int main(void)
+{
+  dm_gsl_init();
+  sampling();
+  stops();
+  errors();
+  options_and_registry();
+  return tap_done();
+}
