@@ -156,7 +156,8 @@ int dm_gp_datablock(dm_gp_session *s, const char *name, size_t nrows,
 int dm_gp_checkpoint(dm_gp_session *s, const char *what, dm_err *e);
 
 /* One raw command (may contain newlines) as its own transaction; `what`
- * names it in errors (NULL: the command itself). */
+ * names it in errors (NULL: the command itself).  Blank lines follow it, so
+ * gnuplot's interactive `help` returns instead of reading the checkpoint. */
 int dm_gp_command(dm_gp_session *s, const char *cmd, const char *what,
                   dm_err *e);
 

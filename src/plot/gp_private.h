@@ -30,6 +30,7 @@ struct dm_gp_session {
   unsigned long generation;   /* number of starts */
   unsigned long serial;       /* checkpoint counter */
   int dirty;              /* a transaction was left without checkpoint */
+  int starting;           /* inside dm_gp_start (exit 127 = not found) */
   char *program;          /* NULL: $DMECH_GNUPLOT or "gnuplot" */
   double timeout;         /* seconds of silence before "hung" */
   FILE *log;

@@ -16,6 +16,7 @@
 #include <spawn.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -89,19 +90,60 @@ static int spawn_fail(dm_err *e, const char *prog, int err)
                     strerror(err));
 }
 
+/* Resolve prog like execvp would (a name with '/' as is, else through
+ * $PATH) into out; 0 or an errno.  Done before spawning so a missing
+ * program is reported the same way whatever posix_spawn does (glibc reports
+ * exec failures, other implementations and valgrind exit with 127). */
+static int find_program(const char *prog, char *out, size_t size)
+{
+  struct stat st;
+  const char *path, *p;
+  int err = ENOENT;
+  if (prog[0] == '\0')
+    return ENOENT;
+  if (strchr(prog, '/') != NULL) {
+    if (stat(prog, &st) != 0)
+      return errno;
+    if (!S_ISREG(st.st_mode) || access(prog, X_OK) != 0)
+      return EACCES;
+    snprintf(out, size, "%s", prog);
+    return 0;
+  }
+  path = getenv("PATH");
+  if (path == NULL)
+    path = "/usr/local/bin:/usr/bin:/bin";
+  for (p = path;; p++) {
+    const char *q = strchr(p, ':');
+    size_t n = q != NULL ? (size_t)(q - p) : strlen(p);
+    if ((size_t)snprintf(out, size, "%.*s%s%s", (int)n, p, n > 0 ? "/" : "",
+                         prog) < size
+        && stat(out, &st) == 0) {
+      if (S_ISREG(st.st_mode) && access(out, X_OK) == 0)
+        return 0;
+      err = EACCES;
+    }
+    if (q == NULL)
+      break;
+    p = q;
+  }
+  return err;
+}
+
 /* Start the program with piped stdio in a new process group (pgid = pid),
  * signals at their defaults and none blocked. */
 int gp_spawn(dm_gp_session *s, dm_err *e)
 {
   int in[2] = {-1, -1}, out[2] = {-1, -1}, err[2] = {-1, -1};
   const char *prog = gp_program(s);
-  char *argv[2];
+  char exe[4096], *argv[2];
   posix_spawn_file_actions_t fa;
   posix_spawnattr_t at;
   sigset_t def, none;
   pid_t pid;
   int rc;
 
+  if ((rc = find_program(prog, exe, sizeof exe)) != 0)
+    return spawn_fail(e, prog, rc);
   if (pipe_hi(in) != 0 || pipe_hi(out) != 0 || pipe_hi(err) != 0) {
     rc = errno;
     close_fd(&in[0]); close_fd(&in[1]); close_fd(&out[0]);
@@ -126,10 +168,7 @@ int gp_spawn(dm_gp_session *s, dm_err *e)
   posix_spawnattr_setsigmask(&at, &none);
   argv[0] = (char *)prog;
   argv[1] = NULL;
-  if (strchr(prog, '/') != NULL)
-    rc = posix_spawn(&pid, prog, &fa, &at, argv, environ);
-  else
-    rc = posix_spawnp(&pid, prog, &fa, &at, argv, environ);
+  rc = posix_spawn(&pid, exe, &fa, &at, argv, environ);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&at);
   close_fd(&in[0]);
@@ -261,6 +300,14 @@ static int gp_died(dm_gp_session *s, dm_err *e)
     snprintf(how, sizeof how, "status unknown");
   else
     describe_status(how, sizeof how, status);
+  if (r >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 127
+      && s->starting) {
+    gp_log(s, "# dmech: gnuplot (pid %ld) could not run (%s)\n", (long)pid, how);
+    forget_process(s);
+    return dm_err_set(e, DM_ENOTFOUND, "gnuplot program '%s' could not be "
+                      "run (%s); install gnuplot or set DMECH_GNUPLOT to its "
+                      "path", gp_program(s), how);
+  }
   gp_buf_append(&s->last_err, s->ebuf.p != NULL ? s->ebuf.p : "", s->ebuf.len);
   n = s->last_err.len;
   tail[0] = '\0';

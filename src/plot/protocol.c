@@ -447,7 +447,9 @@ int dm_gp_start(dm_gp_session *s, dm_err *e)
     return rc;
   gp_log(s, "# dmech: gnuplot started (pid %ld, program %s)\n", (long)s->pid,
          gp_program(s));
+  s->starting = 1;
   rc = probe(s, e);
+  s->starting = 0;
   if (rc != DM_OK) {
     gp_kill(s);
     return rc;
@@ -496,8 +498,11 @@ int dm_gp_command(dm_gp_session *s, const char *cmd, const char *what,
   rc = dm_gp_begin(s, e);
   if (rc == DM_OK)
     rc = gp_append(s, cmd, len, e);
+  /* blank lines are no-ops, but they leave the interactive `help` (which
+   * reads "Subtopic of ...:" answers from stdin) instead of letting it eat
+   * the checkpoint */
   if (rc == DM_OK)
-    rc = gp_append(s, "\n", 1, e);
+    rc = gp_append(s, "\n\n\n\n\n", 5, e);
   if (rc == DM_OK)
     rc = dm_gp_checkpoint(s, what, e);
   return rc;

@@ -418,6 +418,11 @@ static void test_errors(dm_gp_session *s)
   /* a dangling continuation does not swallow the checkpoint */
   m = ask(s, "print 6*7 \\", &rc, &e);
   tap_ok(rc == DM_OK && strcmp(m, "42\n") == 0, "trailing backslash handled");
+  /* the interactive help reads answers from stdin: it must not eat the
+   * checkpoint */
+  m = ask(s, "help set xrange", &rc, &e);
+  tap_ok(rc == DM_OK && strstr(m, "xrange") != NULL,
+         "help returns (%s)", rc ? e.msg : "ok");
   /* messages that are not errors */
   m = ask(s, "print 'note: fine'", &rc, &e);
   tap_ok(rc == DM_OK && strcmp(m, "note: fine\n") == 0, "print output is a message");

@@ -76,6 +76,16 @@ local out = H.capture(dm.plot, { {function(s) return s * s end, range = {0, 2.38
   title = "t^2"}, terminal = "dumb", size = {60, 18}, title = "parabola", xlabel = "t" })
 T.ok(want and H.normalized(out) == H.normalized(want), "terminal = \"dumb\" prints the same plot on stdout")
 
+-- sixel on request: an image on stdout between DCS "ESC P ... q" and ST
+local terms = dm._gp.terminals()
+if (" " .. terms .. " "):find(" sixelgd ", 1, true) then
+  local img = H.capture(dm.plot, { {x, y}, terminal = "sixel", size = {200, 100} })
+  T.ok(img:match("^\27P[%d;]*q") and img:sub(-2) == "\27\\" and #img > 500,
+       "terminal = \"sixel\" writes a sixel image to stdout (" .. #img .. " bytes)")
+else
+  T.skip("this gnuplot has no sixelgd terminal")
+end
+
 -- a file name with a quote, a backslash, ; and spaces
 local odd = dir .. "/it's a \\ file; too.png"
 dm.plot{ {x, y}, output = odd, size = {200, 100} }
