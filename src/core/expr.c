@@ -184,6 +184,26 @@ static dm_expr cons(dm_expr_ctx *ctx, int op, int32_t a, int32_t b, int32_t c)
   return (dm_expr)ctx->n++;
 }
 
+/* The existing node (op, a, b, c) or DM_EXPR_NONE (not for CONST). */
+static dm_expr find(const dm_expr_ctx *ctx, int op, int32_t a, int32_t b,
+                    int32_t c)
+{
+  size_t mask = ctx->hcap - 1;
+  for (size_t j = node_hash(ctx, op, a, b, c) & mask; ctx->htab[j] >= 0;
+       j = (j + 1) & mask)
+    if (node_equal(ctx, &ctx->node[ctx->htab[j]], op, a, b, c))
+      return ctx->htab[j];
+  return DM_EXPR_NONE;
+}
+
+/* A commutative node: b op a if that exists, else a op b as written, so
+ * equal expressions are one node and printing keeps the user's order. */
+static dm_expr cons_comm(dm_expr_ctx *ctx, int op, int32_t a, int32_t b)
+{
+  dm_expr e = find(ctx, op, b, a, -1);
+  return e != DM_EXPR_NONE ? e : cons(ctx, op, a, b, -1);
+}
+
 dm_expr dm_expr_const(dm_expr_ctx *ctx, double x)
 {
   if (isnan(x))
@@ -425,13 +445,12 @@ dm_expr dm_expr_add(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
     return dm_expr_sub(ctx, a, dm_expr_neg(ctx, b));
   if (negative_looking(ctx, a))
     return dm_expr_sub(ctx, b, dm_expr_neg(ctx, a));
-  /* canonical order: constants last, else by handle */
-  if (ka || (!kb && a > b)) {
+  if (ka) {                 /* constants last: x + 1 */
     dm_expr t = a;
     a = b;
     b = t;
   }
-  return cons(ctx, DM_EXPR_ADD, a, b, -1);
+  return cons_comm(ctx, DM_EXPR_ADD, a, b);
 }
 
 dm_expr dm_expr_sub(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
@@ -512,12 +531,7 @@ dm_expr dm_expr_mul(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
   int na = split_pow(ctx, a, &ta), nb = split_pow(ctx, b, &tb);
   if (ta == tb && (long)na + nb != 0 && labs((long)na + nb) < INT32_MAX)
     return dm_expr_powi(ctx, ta, na + nb);
-  if (a > b) {
-    dm_expr t = a;
-    a = b;
-    b = t;
-  }
-  return cons(ctx, DM_EXPR_MUL, a, b, -1);
+  return cons_comm(ctx, DM_EXPR_MUL, a, b);
 }
 
 /* 1/c is exact when c is a power of two (and 1/c does not overflow). */
@@ -708,11 +722,8 @@ static dm_expr compare(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
   double ca, cb;
   if (isc(ctx, a, &ca) && isc(ctx, b, &cb))
     return K(dm_expr__binary_value(op, ca, cb));
-  if ((op == DM_EXPR_EQ || op == DM_EXPR_NE) && a > b) {
-    dm_expr t = a;
-    a = b;
-    b = t;
-  }
+  if (op == DM_EXPR_EQ || op == DM_EXPR_NE)
+    return cons_comm(ctx, op, a, b);
   return cons(ctx, op, a, b, -1);
 }
 

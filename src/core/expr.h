@@ -8,9 +8,10 @@
  *
  * Construction hash-conses (structurally equal nodes are one node), folds
  * constants, applies the safe identities (x+0, x*1, 0*x, x-x, -(-x),
- * (x^m)^n for integers, like terms c1*t + c2*t, x^m*x^n) and orders the
- * operands of commutative operations canonically (constants first in
- * products, last in sums, otherwise by handle).
+ * (x^m)^n for integers, like terms c1*t + c2*t, x^m*x^n, common factors
+ * c*x + c*y) and treats commutative operations canonically: a*b and b*a
+ * are one node, whose operands keep the order of first construction
+ * (constants go first in products, last in sums).
  *
  * Error behaviour: builders return DM_EXPR_NONE on failure (out of memory,
  * wrong arity, invalid handle, unknown name) and record the reason in the

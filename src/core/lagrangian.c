@@ -210,7 +210,7 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
   s = dm_native_compile(p->tape, b->in0, sp->par_values, &p->nat, &nerr);
   if (s == DM_OK)
     p->fn = dm_native_function(p->nat);
-  else if (sp->native == DM_NATIVE_ALWAYS) {
+  else if (sp->native == DM_NATIVE_ALWAYS || s == DM_EINTR) {
     if (b->err != NULL)
       *b->err = nerr;
     return s;

@@ -131,6 +131,7 @@ struct dm_traj *dm_pushtraj(lua_State *L, size_t n, const char *const *coords, u
 struct dm_traj *dm_totraj(lua_State *L, int arg);
 struct dm_traj *dm_checktraj(lua_State *L, int arg);
 void dm_open_traj(lua_State *L);
+void dm_open_expr(lua_State *L);  /* dm.sym, dm.fn, dm.trace, ... (l_expr.c, l_expr.h) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

@@ -11,6 +11,7 @@ static const dm_opener openers[] = {
   dm_open_linalg,
   dm_open_plot,
   dm_open_traj,
+  dm_open_expr,
   NULL
 };
 
