@@ -66,7 +66,7 @@ typedef struct comp_state {
 } comp_state;
 
 static const char *const comp_options[] = {"order", "scheme", "base", "h", "tol", "maxiter",
-                                           "explicit", NULL};
+                                           "simplified", "explicit", NULL};
 
 static void comp_free(dm_integrator *I)
 {
@@ -201,5 +201,5 @@ const dm_integrator_type dm_integ_composition = {
   0,
   DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS,
   comp_options,
-  comp_alloc, comp_step, comp_jacobian, NULL, comp_reset, comp_free
+  comp_alloc, comp_step, comp_jacobian, NULL, NULL, comp_reset, comp_free
 };

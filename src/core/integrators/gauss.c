@@ -15,8 +15,8 @@
 
 #include <string.h>
 
-static const char *const gauss_options[] = {"stages", "h", "tol", "maxiter", NULL};
-static const char *const midpoint_options[] = {"h", "tol", "maxiter", NULL};
+static const char *const gauss_options[] = {"stages", "h", "tol", "maxiter", "simplified", NULL};
+static const char *const midpoint_options[] = {"h", "tol", "maxiter", "simplified", NULL};
 
 static int make(dm_integrator *I, size_t s, dm_err *e)
 {
@@ -82,7 +82,7 @@ const dm_integrator_type dm_integ_midpoint = {
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
   midpoint_options,
   midpoint_alloc, dm_prk_type_step, dm_prk_type_jacobian, midpoint_dlegendre,
-  dm_prk_type_reset, dm_prk_type_free
+  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
 };
 
 const dm_integrator_type dm_integ_gauss = {
@@ -93,5 +93,5 @@ const dm_integrator_type dm_integ_gauss = {
     | DM_INTEG_EXACT_JAC,
   gauss_options,
   gauss_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_reset, dm_prk_type_free
+  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
 };

@@ -167,5 +167,5 @@ const dm_integrator_type dm_integ_gsl = {
   0,
   DM_INTEG_FORCES,
   gsl_options,
-  gsl_alloc, gsl_step, NULL, NULL, gsl_reset, gsl_free_state
+  gsl_alloc, gsl_step, NULL, NULL, NULL, gsl_reset, gsl_free_state
 };

@@ -113,6 +113,8 @@ int dm_prk_type_jacobian(dm_integrator *I, double h, const double *q0,
 int dm_prk_type_dlegendre(dm_integrator *I, double h, const double *q0,
                           const double *q1, double *p0, double *p1, double *Ld,
                           dm_err *e);
+int dm_prk_type_advance(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                        long *done, dm_err *e);
 void dm_prk_type_reset(dm_integrator *I);
 void dm_prk_type_free(dm_integrator *I);
 /* Common alloc tail: engine for tableau t, flags/order from the tableau. */

@@ -20,6 +20,8 @@ const dm_option_desc dm_integ_options[] = {
   {"tol", DM_OPT_DOUBLE, OPT(tol), DBL_EPSILON, 1e-2,
    "Newton stops when the relative update is <= tol (default 10 eps: round-off)"},
   {"maxiter", DM_OPT_INT, OPT(maxiter), 1, 1000, "Newton iteration cap (default 50)"},
+  {"simplified", DM_OPT_BOOL, OPT(simplified), 0, 1,
+   "Newton: reuse the factored exact Jacobian while the updates contract tenfold (default true)"},
   {"order", DM_OPT_INT, OPT(order), 4, 8, "composition: order 4, 6 or 8"},
   {"scheme", DM_OPT_STRING, OPT(scheme), 0, 0,
    "composition coefficients: yoshida4, yoshida6, kahanli6, mclachlan8, kahanli8 (default by order)"},
@@ -38,6 +40,7 @@ void dm_integ_opts_init(dm_integ_opts *o)
   memset(o, 0, sizeof *o);
   o->tol = 10.0 * DBL_EPSILON;
   o->maxiter = 50;
+  o->simplified = 1;
   o->order = 4;
   strcpy(o->base, "trapezoid");
   o->explicit_sv = 1;
@@ -291,12 +294,35 @@ static int emit(dm_integrator *I, dm_sink_fn sink, void *ctx, double t, const do
   return DM_OK;
 }
 
+/* Up to nsteps steps in place without the type's fast path: each step goes
+ * to scratch and is copied back only when it succeeded. */
+static int advance_steps(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                         long *done, dm_err *e)
+{
+  size_t n = I->n;
+  double *q1 = I->scratch, *p1 = I->scratch + n;
+  long k;
+  int st = DM_OK;
+  for (k = 0; k < nsteps; k++) {
+    if (dm_interrupted()) {
+      st = DM_EINTR;
+      break;
+    }
+    if ((st = dm_integrator_step(I, h, q, p, q1, p1, e)) != DM_OK)
+      break;
+    memcpy(q, q1, n * sizeof(double));
+    memcpy(p, p1, n * sizeof(double));
+  }
+  *done = k;
+  return st;
+}
+
 int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double h,
                       long nsteps, long every, dm_sink_fn sink, void *ctx,
                       dm_run_info *info, dm_err *e)
 {
   size_t n = I->n;
-  double *q1 = I->scratch, *p1 = I->scratch + n, *v = I->scratch + 2 * n;
+  double *v = I->scratch + 2 * n;
   long k = 0, last_emit = -1, nsamples = 0;
   int st = DM_OK, sink_failed = 0;
   dm_err le;
@@ -315,30 +341,32 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
     goto done;
   }
   last_emit = 0;
-  for (k = 1; k <= nsteps; k++) {
-    if (dm_interrupted()) {
-      st = dm_err_set(e, DM_EINTR, "interrupted after step %ld of %ld (t = %.17g); the trajectory "
-                      "up to there is kept", k - 1, nsteps, t0 + (double)(k - 1) * h);
+  while (k < nsteps) {
+    long chunk = every - k % every, got = 0;
+    if (chunk > nsteps - k)
+      chunk = nsteps - k;
+    st = I->type->advance ? I->type->advance(I, h, chunk, q, p, &got, &le)
+                          : advance_steps(I, h, chunk, q, p, &got, &le);
+    k += got;
+    if (st == DM_EINTR) {
+      dm_err_set(e, DM_EINTR, "interrupted after step %ld of %ld (t = %.17g); the trajectory "
+                 "up to there is kept", k, nsteps, t0 + (double)k * h);
       break;
     }
-    if ((st = dm_integrator_step(I, h, q, p, q1, p1, &le)) != DM_OK) {
-      dm_err_set(e, st, "step %ld of %ld from t = %.17g failed: %s", k, nsteps,
-                 t0 + (double)(k - 1) * h, le.msg);
+    if (st != DM_OK) {
+      dm_err_set(e, st, "step %ld of %ld from t = %.17g failed: %s", k + 1, nsteps,
+                 t0 + (double)k * h, le.msg);
       break;
     }
-    memcpy(q, q1, n * sizeof(double));
-    memcpy(p, p1, n * sizeof(double));
     if (k % every == 0 || k == nsteps) {
       if ((st = emit(I, sink, ctx, t0 + (double)k * h, q, p, v, &nsamples, &le)) != DM_OK) {
         dm_err_set(e, st, "after step %ld (t = %.17g): %s", k, t0 + (double)k * h, le.msg);
         sink_failed = 1;
-        k++;
         break;
       }
       last_emit = k;
     }
   }
-  k--;            /* steps completed */
   if (st != DM_OK && !sink_failed && last_emit != k) {
     dm_err ign;
     if (emit(I, sink, ctx, t0 + (double)k * h, q, p, v, &nsamples, &ign) == DM_OK)
@@ -346,8 +374,8 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
   }
 done:
   if (info) {
-    info->steps = k < 0 ? 0 : k;
-    info->t = t0 + (double)(k < 0 ? 0 : k) * h;
+    info->steps = k;
+    info->t = t0 + (double)k * h;
     info->samples = nsamples;
     info->status = st;
     info->residual = I->stats.residual;

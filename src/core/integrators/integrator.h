@@ -45,6 +45,7 @@ typedef struct dm_integ_opts {
   double h;            /* default step size of run() (informational here) */
   double tol;          /* Newton: stop when |update| <= tol * scale */
   int maxiter;         /* Newton iteration cap */
+  int simplified;      /* Newton: reuse the factored Jacobian while it converges fast */
   int order;           /* composition: 4, 6 or 8 */
   char scheme[DM_INTEG_STRMAX];  /* composition table ("" = default for order) */
   char base[DM_INTEG_STRMAX];    /* composition base step: trapezoid|midpoint */
@@ -111,6 +112,12 @@ typedef struct dm_integrator_type {
    * NULL: not variational. */
   int (*dlegendre)(dm_integrator *I, double h, const double *q0, const double *q1,
                    double *p0, double *p1, double *Ld, dm_err *e);
+  /* Optional fast path of the run loop: up to nsteps steps of h in place
+   * on (q, p), polling dm_interrupted() before each step (DM_EINTR, no
+   * message).  *done = steps completed; on any failure q, p hold the state
+   * after *done steps.  NULL: the run loop calls step() repeatedly. */
+  int (*advance)(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                 long *done, dm_err *e);
   /* Forget step history (predictor, compensated-summation carries). */
   void (*reset)(dm_integrator *I);
   void (*free)(dm_integrator *I);
@@ -119,6 +126,7 @@ typedef struct dm_integrator_type {
 /* Statistics of the last step and running totals. */
 typedef struct dm_integ_stats {
   int iters;            /* Newton iterations of the last step (0 if explicit) */
+  int jacs;             /* Jacobian factorisations in the last step */
   double residual;      /* final max-norm residual / update of the last solve */
   double tol;           /* the tolerance it was compared with */
   long steps;           /* steps taken since new() or reset */

@@ -7,8 +7,8 @@
 #include <config.h>
 #include "integ_impl.h"
 
-static const char *const lobatto_options[] = {"stages", "h", "tol", "maxiter", "explicit", NULL};
-static const char *const trapezoid_options[] = {"h", "tol", "maxiter", "explicit", NULL};
+static const char *const lobatto_options[] = {"stages", "h", "tol", "maxiter", "simplified", "explicit", NULL};
+static const char *const trapezoid_options[] = {"h", "tol", "maxiter", "simplified", "explicit", NULL};
 
 static int make(dm_integrator *I, size_t s, dm_err *e)
 {
@@ -46,7 +46,7 @@ const dm_integrator_type dm_integ_trapezoid = {
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
   trapezoid_options,
   trapezoid_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_reset, dm_prk_type_free
+  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
 };
 
 const dm_integrator_type dm_integ_lobatto = {
@@ -58,5 +58,5 @@ const dm_integrator_type dm_integ_lobatto = {
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
   lobatto_options,
   lobatto_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_reset, dm_prk_type_free
+  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
 };

@@ -5,7 +5,7 @@
 #include <config.h>
 #include "integ_impl.h"
 
-static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", NULL};
+static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", "simplified", NULL};
 
 static int prk_alloc(dm_integrator *I, dm_err *e)
 {
@@ -28,5 +28,5 @@ const dm_integrator_type dm_integ_prk = {
   DM_INTEG_SYMPLECTIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
   prk_options,
   prk_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_reset, dm_prk_type_free
+  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
 };

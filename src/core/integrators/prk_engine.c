@@ -8,7 +8,10 @@
  * Newton uses the exact Jacobian
  *   dR_i/dV_k = d_ik Lvv_i + h a_ik Lvq_i - h at_ik (Lvq_k^T + Fv_k)
  *               - h^2 sum_j at_ij a_jk (Lqq_j + Fq_j),
- * factored with GSL LU, and iterates to round-off: stop when the scaled
+ * factored with GSL LU (by default as a simplified Newton: the Jacobian
+ * factored at the first iterate is reused while the updates contract at
+ * least tenfold, and refreshed otherwise; option simplified = false
+ * refactors every iteration), and iterates to round-off: stop when the scaled
  * update is <= tol (default 10 eps), or, once the update is below
  * DM_NEWTON_ACCEPT = 1e-10 (round-off regime of an ill-conditioned system),
  * after two updates that did not halve the best one; at most maxiter
@@ -31,6 +34,7 @@
  */
 #include <config.h>
 #include "prk_impl.h"
+#include "interrupt.h"
 
 #include <float.h>
 #include <math.h>
@@ -66,6 +70,7 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
   P->forced = sys->force != NULL;
   P->tol = tol;
   P->maxiter = maxiter;
+  P->simplified = 1;
   P->E_ratio = NAN;
   if ((P->tab = dm_tableau_copy(t)) == NULL) {
     free(P);
@@ -292,20 +297,23 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
                   const double *q1t, dm_integ_stats *stt, dm_err *e)
 {
   size_t N = nunk(P, mode), i;
-  double d = HUGE_VAL, dprev = HUGE_VAL, rn = HUGE_VAL;
-  int it, st, sg, stall = 0, ok = 0;
+  double d = HUGE_VAL, dbest = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
+  int it, st, sg, stall = 0, ok = 0, jac = 1, njac = 0;
   for (it = 1; it <= P->maxiter; it++) {
-    if ((st = assemble(P, mode, h, q0, p0, q1t, 1, e)) != DM_OK)
+    if ((st = assemble(P, mode, h, q0, p0, q1t, jac, e)) != DM_OK)
       return st;
     rn = dm_norm_inf(P->R, N);
     if (!isfinite(rn))
       return dm_err_set(e, DM_EDOM, "non-finite residual in the stage equations (h = %g, iteration %d)",
                         h, it);
-    st = dm_lu_factor(P->Jm, N, P->perm, &sg);
-    if (st == DM_ESINGULAR)
-      return dm_prk_singular(P, "stage equations", h, e);
-    if (st != DM_OK)
-      return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
+    if (jac) {
+      njac++;
+      st = dm_lu_factor(P->Jm, N, P->perm, &sg);
+      if (st == DM_ESINGULAR)
+        return dm_prk_singular(P, "stage equations", h, e);
+      if (st != DM_OK)
+        return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
+    }
     dm_lu_solve(P->Jm, N, P->perm, P->R);
     for (i = 0; i < N; i++)
       P->X[i] -= P->R[i];
@@ -317,24 +325,34 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
       break;
     }
     /* in the round-off regime, stop once the updates stop contracting */
-    if (dm_newton_stalled(d, &dprev, &stall)) {
+    if (dm_newton_stalled(d, &dbest, &stall)) {
       ok = 1;
       break;
     }
+    /* simplified Newton: keep the factored exact Jacobian while the updates
+     * contract at least tenfold, otherwise refresh it */
+    jac = !P->simplified || d > 0.1 * dlast;
+    dlast = d;
   }
   if (it > P->maxiter)
     it = P->maxiter;
   if (stt) {
     stt->iters = it;
+    stt->jacs = njac;
     stt->residual = d;
     stt->tol = P->tol;
     stt->iters_total += it;
   }
+  P->njac = njac;
   if (!ok)
     return dm_err_set(e, DM_ENOCONV,
                       "Newton on the stage equations did not converge in %d iterations: "
                       "relative update %.3g > tol %.3g (residual %.3g, h = %g)",
                       it, d, P->tol, rn, h);
+  /* The stage forces were evaluated before the last update; when that update
+   * is at round-off they are the converged ones, otherwise evaluate again. */
+  if (d <= 1e-12 && mode != DM_PRK_DLEG)
+    return DM_OK;
   return assemble(P, mode, h, q0, p0, q1t, 0, e);
 }
 
@@ -430,6 +448,9 @@ int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
       dm_prk_kahan(n, p0, P->dp, P->cp, P->p1w);
     }
   }
+  for (a = 0; a < n && st == DM_OK; a++)
+    if (!isfinite(P->q1w[a]) || !isfinite(P->p1w[a]))
+      st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
   if (st != DM_OK) {
     P->hist = 0;
     P->svf_valid = 0;
@@ -546,6 +567,7 @@ int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
   if (st != DM_OK)
     return st;
   I->state = P;
+  P->simplified = I->opt.simplified;
   I->order = t->order;
   I->flags = DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;
   if (I->m == 0)
@@ -576,6 +598,26 @@ int dm_prk_type_dlegendre(dm_integrator *I, double h, const double *q0,
                           dm_err *e)
 {
   return dm_prk_dlegendre(I->state, h, q0, q1, p0, p1, Ld, &I->stats, e);
+}
+
+int dm_prk_type_advance(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                        long *done, dm_err *e)
+{
+  dm_prk *P = I->state;
+  long k;
+  int st = DM_OK;
+  if (P->explicit_sv && P->m == 0)
+    return dm_prk_verlet_advance(P, h, nsteps, q, p, done, &I->stats, e);
+  for (k = 0; k < nsteps; k++) {
+    if (dm_interrupted()) {
+      st = DM_EINTR;
+      break;
+    }
+    if ((st = dm_prk_step(P, h, q, p, q, p, &I->stats, e)) != DM_OK)
+      break;      /* outputs are written only on success */
+  }
+  *done = k;
+  return st;
 }
 
 void dm_prk_type_reset(dm_integrator *I)

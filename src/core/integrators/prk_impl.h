@@ -21,6 +21,8 @@ struct dm_prk {
   int distinct_nodes;          /* predictor may interpolate */
   double tol;
   int maxiter;
+  int simplified;              /* reuse the factored Jacobian while converging fast */
+  int njac;                    /* Jacobian factorisations in the last solve */
   /* constraints: multipliers at the stages K (interior stages of a Lobatto
    * type tableau), plus mu0 on p0 and g(q1) = 0 (see prk_constrained.c) */
   size_t nK, K[DM_TABLEAU_SMAX];
@@ -43,6 +45,7 @@ struct dm_prk {
   double *cq, *cp;             /* Kahan carries */
   /* separable systems */
   double *Minv;                /* n x n */
+  int unit_mass;               /* M = I: skip the M^{-1} product */
   double *svf;                 /* Lq at hq1 (first same as last) */
   int svf_valid;
   dm_legendre_ws *leg;
@@ -67,5 +70,7 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
 int dm_prk_verlet_setup(dm_prk *P, dm_err *e);
 int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
                        int cont, double *q1, double *p1, dm_integ_stats *st, dm_err *e);
+int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p, long *done,
+                          dm_integ_stats *st, dm_err *e);
 
 #endif

@@ -119,5 +119,5 @@ const dm_integrator_type dm_integ_rk4 = {
   4,
   DM_INTEG_EXPLICIT | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
   rk4_options,
-  rk4_alloc, rk4_step, rk4_jacobian, NULL, NULL, rk4_free
+  rk4_alloc, rk4_step, rk4_jacobian, NULL, NULL, NULL, rk4_free
 };

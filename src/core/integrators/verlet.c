@@ -17,6 +17,7 @@
 #include <math.h>
 #include <string.h>
 #include <gsl/gsl_linalg.h>
+#include "interrupt.h"
 
 static int is_lobatto2(const dm_tableau *t)
 {
@@ -39,6 +40,10 @@ int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
     return dm_err_set(e, DM_EINVAL, "system '%s' is flagged separable but its mass matrix is not "
                       "symmetric positive definite", sys->name ? sys->name : "?");
   P->explicit_sv = 1;
+  P->unit_mass = 1;
+  for (size_t i = 0; i < n * n; i++)
+    if (sys->mass[i] != (i / n == i % n ? 1.0 : 0.0))
+      P->unit_mass = 0;
   return DM_OK;
 }
 
@@ -52,6 +57,11 @@ static int force_at(dm_prk *P, const double *q, double *f, dm_err *e)
 static void minv_mul(const dm_prk *P, const double *x, double *y)
 {
   size_t n = P->n, i, j;
+  if (P->unit_mass) {
+    for (i = 0; i < n; i++)
+      y[i] = x[i];
+    return;
+  }
   for (i = 0; i < n; i++) {
     double acc = 0.0;
     for (j = 0; j < n; j++)
@@ -190,4 +200,92 @@ int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
   }
   P->svf_valid = 1;
   return DM_OK;
+}
+
+/* The run loop's fast path for unconstrained Stormer-Verlet: nsteps steps
+ * in place, one force evaluation per step (first same as last), Kahan
+ * compensated updates, no copies beyond the state itself.  Same arithmetic
+ * as dm_prk_verlet_step, so results are bitwise identical to stepping. */
+int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p, long *done,
+                          dm_integ_stats *stt, dm_err *e)
+{
+  const dm_system *sys = P->sys;
+  size_t n = P->n, i;
+  double *f0 = P->Lq, *f1 = P->Lq + n, *u = P->X, *q1 = P->q1w, *ph = P->dp, *tmp;
+  double *cq = P->cq, *cp = P->cp;
+  dm_lag_out o = {0, NULL, P->Lv + n, NULL, NULL, NULL};
+  long k;
+  int st = DM_OK, rc;
+  int cont = P->hist && memcmp(q, P->hq1, n * sizeof(double)) == 0
+             && memcmp(p, P->hp1, n * sizeof(double)) == 0;
+  *done = 0;
+  if (!cont) {
+    memset(cq, 0, n * sizeof(double));
+    memset(cp, 0, n * sizeof(double));
+    P->svf_valid = 0;
+  }
+  if (cont && P->svf_valid)
+    memcpy(f0, P->svf, n * sizeof(double));
+  else if ((st = force_at(P, q, f0, e)) != DM_OK)
+    return st;
+  P->hist = 0;
+  P->svf_valid = 0;
+  memset(P->v1w, 0, n * sizeof(double));
+  for (k = 0; k < nsteps; k++) {
+    int bad = 0;
+    if (dm_interrupted()) {
+      st = DM_EINTR;
+      break;
+    }
+    for (i = 0; i < n; i++)
+      ph[i] = p[i] + 0.5 * h * f0[i];
+    minv_mul(P, ph, u);
+    for (i = 0; i < n; i++) {
+      double y = h * u[i] - cq[i], t = q[i] + y;
+      cq[i] = (t - q[i]) - y;
+      q1[i] = t;
+    }
+    o.Lq = f1;
+    if ((rc = sys->lagrangian(sys->data, q1, P->v1w, sys->par, DM_LAG_Q, &o, P->work)) != 0) {
+      st = dm_eval_lag(sys, q1, P->v1w, DM_LAG_Q, &o, P->work, e);   /* formats the message */
+      if (st == DM_OK)
+        st = dm_err_set(e, rc > 0 ? DM_EDOM : DM_ECALLBACK, "force evaluation failed");
+      break;
+    }
+    for (i = 0; i < n; i++) {
+      double y = 0.5 * h * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
+      if (!isfinite(t) || !isfinite(q1[i]))
+        bad = 1;
+      cp[i] = (t - p[i]) - y;
+      ph[i] = t;
+    }
+    if (bad) {
+      st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
+      break;
+    }
+    for (i = 0; i < n; i++) {
+      q[i] = q1[i];
+      p[i] = ph[i];
+    }
+    tmp = f0;
+    f0 = f1;
+    f1 = tmp;
+  }
+  *done = k;
+  if (stt) {
+    stt->steps += k;
+    stt->iters = 0;
+    stt->residual = 0.0;
+  }
+  if (st == DM_OK || st == DM_EINTR) {
+    /* history for the next call: continuation, carries, FSAL force */
+    memcpy(P->hq1, q, n * sizeof(double));
+    memcpy(P->hp1, p, n * sizeof(double));
+    memcpy(P->svf, f0, n * sizeof(double));
+    memcpy(P->X + n, u, n * sizeof(double));
+    memcpy(P->hV, P->X, 2 * n * sizeof(double));
+    P->hist = 1;
+    P->svf_valid = 1;
+  }
+  return st;
 }
