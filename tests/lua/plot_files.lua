@@ -25,6 +25,14 @@ dm.plot{ {x, y}, output = dir .. "/default.png" }
 w, h = H.png_size(dir .. "/default.png")
 T.ok(w == 640 and h == 480, "default PNG size 640x480 (got " .. tostring(w) .. "x" .. tostring(h) .. ")")
 
+-- shorthand: dm.plot{x, y, ...} and dm.plot{y, ...} are one series
+dm.plot{ x, y, title = "shorthand", output = dir .. "/short.svg" }
+local sinfo = H.svg(H.read(dir .. "/short.svg"))
+T.ok(sinfo and #sinfo.groups == 1, "dm.plot{x, y, ...} plots one series")
+dm.plot{ {2.385, 1, 3}, output = dir .. "/index.svg" }
+sinfo = H.svg(H.read(dir .. "/index.svg"))
+T.ok(sinfo and #sinfo.groups == 1, "dm.plot{y} plots y against its index")
+
 -- a 1x2 multiplot in one PNG
 dm.plot{ {{x, y, title = "sin"}, {x, x:map(math.cos), title = "cos"}, title = "left"},
          {function(t) return t * t end, range = {0, 2.385}, title = "t^2"},
