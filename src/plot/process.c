@@ -205,6 +205,18 @@ static void reap(dm_gp_session *s, int *status)
   while (r < 0 && errno == EINTR);
 }
 
+/* 1 when pid has exited (left as a zombie, not reaped: its pid, which is
+ * also the process group id, cannot be reused while we kill the group),
+ * 0 while it runs, -1 when it is not our child any more. */
+static int exited(pid_t pid)
+{
+  siginfo_t si;
+  memset(&si, 0, sizeof si);
+  if (waitid(P_PID, (id_t)pid, &si, WEXITED | WNOHANG | WNOWAIT) != 0)
+    return errno == EINTR ? 0 : -1;
+  return si.si_pid == pid ? 1 : 0;
+}
+
 static void forget_process(dm_gp_session *s)
 {
   close_fd(&s->fd_in);
@@ -249,9 +261,11 @@ int gp_alive(dm_gp_session *s)
   pid_t r;
   if (s->pid <= 0)
     return 0;
-  r = waitpid(s->pid, &status, WNOHANG);
-  if (r == s->pid || (r < 0 && errno == ECHILD)) {
-    kill(-s->pid, SIGKILL);               /* leftover helpers */
+  if ((r = exited(s->pid)) != 0) {
+    if (r > 0) {
+      kill(-s->pid, SIGKILL);             /* leftover helpers */
+      reap(s, &status);
+    }
     gp_log(s, "# dmech: gnuplot (pid %ld) had exited\n", (long)s->pid);
     forget_process(s);
     return 0;
@@ -286,13 +300,12 @@ static int gp_died(dm_gp_session *s, dm_err *e)
   size_t n;
   for (i = 0; i < 50; i++) {                 /* up to 0.5 s */
     struct timespec ts = {0, 10000000L};
-    r = waitpid(pid, &status, WNOHANG);
-    if (r != 0)
+    if ((r = exited(pid)) != 0)
       break;
     nanosleep(&ts, NULL);
   }
-  kill(-pid, SIGKILL);
-  if (r == 0) {
+  if (r >= 0) {
+    kill(-pid, SIGKILL);                     /* helpers; gnuplot if still up */
     kill(pid, SIGKILL);
     reap(s, &status);
   }

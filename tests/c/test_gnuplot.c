@@ -497,7 +497,7 @@ static void test_big_data(dm_gp_session *s, size_t n)
          atol(dm_gp_messages(s, NULL)), now() - t0);
   tap_ok(png_size(png, &w, &h) == 0 && w == 300, "big PNG written");
   {
-    char cmd[200], line[64];
+    char cmd[700], line[64];
     FILE *f;
     int left = -1;
     snprintf(cmd, sizeof cmd, "ls %s/dmech-gnuplot-*/ 2>/dev/null | grep -c dat",
