@@ -5,6 +5,7 @@
 #include <config.h>
 #include <math.h>
 #include <string.h>
+#include <gsl/gsl_sf_elljac.h>
 #include "core/status.h"
 #include "core/builtin_systems.h"
 #include "core/integrators/integrator.h"
@@ -93,6 +94,34 @@ static void t23(void)
            cases[i].order, err[0], err[cases[i].k - 1]);
     if (i == 0)
       tap_ok(fabs(err[1] - 9.401e-4) < 5e-8, "T2.3 G1 error at n = 20 is 9.401e-4 (got %.4e)", err[1]);
+  }
+  dm_system_release(&s);
+}
+
+/* T2.4: q(0) = 0, p(0) = 2k has q = 2 asin(k sn(t|k^2)), p = 2k cn(t|k^2);
+ * k = 1/2, t = 10, h = 0.1: signed errors in q of G1, G2, L2. */
+static void t24(void)
+{
+  static const struct {
+    const char *m;
+    int s;
+    double err;
+  } c[] = {{"gauss", 1, 5.43e-3}, {"gauss", 2, 7.30e-7}, {"trapezoid", 0, -1.57e-3}};
+  const double qx = 0.11425225501760429923, px = -0.99345891495522782714;
+  double sn, cn, dn;
+  dm_system s;
+  size_t i;
+  gsl_sf_elljac_e(10.0, 0.25, &sn, &cn, &dn);
+  tap_ok(fabs(2 * asin(0.5 * sn) - qx) < 1e-13 && fabs(cn - px) < 1e-13,
+         "T2.4 reference q(10), p(10) from GSL elljac (%.2g, %.2g)", 2 * asin(0.5 * sn) - qx, cn - px);
+  dm_builtin_pendulum(&s, 1.0, NULL);
+  for (i = 0; i < sizeof c / sizeof c[0]; i++) {
+    dm_integrator *I = make(&s, c[i].m, c[i].s, 1);
+    double q = 0.0, p = 1.0;
+    int st = dm_integrator_run(I, 0.0, &q, &p, 0.1, 100, 100, NULL, NULL, NULL, NULL);
+    tap_ok(st == DM_OK && fabs((q - qx) / c[i].err - 1.0) < 0.01,
+           "T2.4 %s s=%d h = 0.1: error in q(10) %.4g (spec %.3g)", c[i].m, c[i].s, q - qx, c[i].err);
+    dm_integrator_free(I);
   }
   dm_system_release(&s);
 }
@@ -323,6 +352,7 @@ int main(void)
   dm_gsl_init();
   t22();
   t23();
+  t24();
   t25();
   t28();
   defects();

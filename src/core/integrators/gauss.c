@@ -87,10 +87,11 @@ const dm_integrator_type dm_integ_midpoint = {
 
 const dm_integrator_type dm_integ_gauss = {
   "gauss",
-  "Gauss-Legendre Galerkin integrator with s stages (default 2); order 2s, symmetric, symplectic",
+  "Gauss-Legendre Galerkin integrator with s stages (default 2); order 2s, symmetric, symplectic "
+  "(constraints only with s = 1)",
   0,
   DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
-    | DM_INTEG_EXACT_JAC,
+    | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
   gauss_options,
   gauss_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
   dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free

@@ -140,8 +140,7 @@ int dm_integrator_new(const dm_system *sys, const char *method,
     return dm_err_set(e, DM_ENOTFOUND, "unknown integration method '%s' (known: %s)",
                       method ? method : "(null)", buf);
   }
-  if (sys->m > 0 && !(type->flags & DM_INTEG_CONSTRAINTS) && strcmp(type->name, "gauss") != 0
-      && strcmp(type->name, "composition") != 0)
+  if (sys->m > 0 && !(type->flags & DM_INTEG_CONSTRAINTS))
     return dm_err_set(e, DM_EUNSUP, "method '%s' does not support holonomic constraints "
                       "(use lobatto, trapezoid or midpoint)", method);
   if (opts && (!(opts->tol > 0.0) || opts->maxiter < 1))
