@@ -209,6 +209,7 @@ int dm_tableau_lobatto_nodes(size_t s, double *x, dm_err *e)
     /* Chebyshev-Lobatto guess, then Newton on P'_N using
      * (1 - x^2) P''_N = 2 x P'_N - N (N+1) P_N. */
     long double z = -cosl(3.14159265358979323846264338327950288L * (long double)k / N);
+    long double dzprev = HUGE_VALL;
     int it;
     for (it = 0; it < 100; it++) {
       long double p, dp, d2p, dz;
@@ -216,8 +217,10 @@ int dm_tableau_lobatto_nodes(size_t s, double *x, dm_err *e)
       d2p = (2.0L * z * dp - (long double)N * (N + 1) * p) / (1.0L - z * z);
       dz = dp / d2p;
       z -= dz;
-      if (fabsl(dz) <= 4.0L * LDBL_EPSILON)
+      /* converged, or at the precision floor (long double may be double) */
+      if (fabsl(dz) <= 4.0L * LDBL_EPSILON || (fabsl(dz) < 1e-14L && fabsl(dz) >= dzprev))
         break;
+      dzprev = fabsl(dz);
     }
     if (it == 100 || !(fabsl(z) < 1.0L))
       return dm_err_set(e, DM_ENOCONV, "lobatto: Newton for node %zu of %zu did not converge", k + 1, s);
