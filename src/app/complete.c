@@ -112,6 +112,7 @@ static char **dm_completion(const char *text, int start, int end)
   (void)start;
   (void)end;
   rl_attempted_completion_over = 1;        /* never fall back to file names */
+  rl_completion_append_character = '\0';   /* reset by Readline each time */
   if (L == NULL)
     return NULL;
   top = lua_gettop(L);

@@ -44,12 +44,36 @@ static char *history_path = NULL;
  * ======================================================================= */
 
 #ifdef HAVE_READLINE
-static volatile sig_atomic_t prompt_sigint = 0, prompt_sigwinch = 0;
+/* Signals at the prompt reach the loop through a pipe (the self-pipe trick):
+ * the handler only writes a byte, and poll() watches the pipe beside the
+ * terminal, so a Ctrl-C arriving at any moment is seen at the next wake-up. */
+static int sigpipe_fd[2] = {-1, -1};
 static char *cb_line;
 static int cb_done;
 
-static void on_sigint(int sig) { (void)sig; prompt_sigint = 1; }
-static void on_sigwinch(int sig) { (void)sig; prompt_sigwinch = 1; }
+static void on_prompt_signal(int sig)
+{
+  int saved = errno;
+  char c = sig == SIGINT ? 'i' : 'w';
+  if (write(sigpipe_fd[1], &c, 1) < 0) {
+    /* pipe full: a wake-up is already pending */
+  }
+  errno = saved;
+}
+
+static int open_sigpipe(void)
+{
+  int i;
+  if (sigpipe_fd[0] >= 0)
+    return 0;
+  if (pipe(sigpipe_fd) != 0)
+    return -1;
+  for (i = 0; i < 2; i++) {
+    fcntl(sigpipe_fd[i], F_SETFL, fcntl(sigpipe_fd[i], F_GETFL) | O_NONBLOCK);
+    fcntl(sigpipe_fd[i], F_SETFD, FD_CLOEXEC);
+  }
+  return 0;
+}
 
 static void on_line(char *line)
 {
@@ -64,41 +88,48 @@ static int rl_getline(const char *prompt, char **line)
 {
   struct sigaction sa, oldint, oldwinch;
   int interrupted = 0;
+  char c;
+  while (read(sigpipe_fd[0], &c, 1) == 1)
+    ;                                   /* forget stale wake-ups */
   memset(&sa, 0, sizeof sa);
   sigemptyset(&sa.sa_mask);
-  sa.sa_handler = on_sigint;           /* no SA_RESTART: poll returns EINTR */
+  sa.sa_handler = on_prompt_signal;
+  sa.sa_flags = SA_RESTART;
   sigaction(SIGINT, &sa, &oldint);
-  sa.sa_handler = on_sigwinch;
   sigaction(SIGWINCH, &sa, &oldwinch);
-  prompt_sigint = 0;
   cb_done = 0;
   cb_line = NULL;
   rl_callback_handler_install(prompt, on_line);
   while (!cb_done) {
-    struct pollfd pfd = {fileno(rl_instream), POLLIN, 0};
-    int r = poll(&pfd, 1, -1);
-    if (prompt_sigwinch) {
-      prompt_sigwinch = 0;
-      rl_resize_terminal();
-    }
-    if (prompt_sigint) {
-      prompt_sigint = 0;
-      rl_free_line_state();
-      rl_callback_sigcleanup();
-      rl_replace_line("", 0);
-      rl_point = rl_end = 0;
-      rl_crlf();
-      rl_callback_handler_remove();
-      interrupted = 1;
-      break;
-    }
+    struct pollfd pfd[2] = {{fileno(rl_instream), POLLIN, 0}, {sigpipe_fd[0], POLLIN, 0}};
+    int r = poll(pfd, 2, -1);
     if (r < 0) {
       if (errno == EINTR)
         continue;
       on_line(NULL);
       break;
     }
-    rl_callback_read_char();
+    if (pfd[1].revents & POLLIN) {
+      int sigint = 0, winch = 0;
+      while (read(sigpipe_fd[0], &c, 1) == 1) {
+        sigint |= c == 'i';
+        winch |= c == 'w';
+      }
+      if (winch)
+        rl_resize_terminal();
+      if (sigint) {
+        rl_free_line_state();
+        rl_callback_sigcleanup();
+        rl_replace_line("", 0);
+        rl_point = rl_end = 0;
+        rl_crlf();
+        rl_callback_handler_remove();
+        interrupted = 1;
+        break;
+      }
+    }
+    if (pfd[0].revents & (POLLIN | POLLHUP | POLLERR))
+      rl_callback_read_char();
   }
   sigaction(SIGINT, &oldint, NULL);
   sigaction(SIGWINCH, &oldwinch, NULL);
@@ -372,7 +403,7 @@ void dm_repl(lua_State *L)
 {
   int status, expr = 0, quiet = 0;
 #ifdef HAVE_READLINE
-  use_readline = isatty(STDIN_FILENO);
+  use_readline = isatty(STDIN_FILENO) && open_sigpipe() == 0;
   if (use_readline) {
     rl_readline_name = DM_PROGNAME;
     rl_catch_signals = 0;

@@ -160,7 +160,10 @@ int main(void)
 
   mark = s.len;
   send(&s, "v = dm.vec{3, 4}\r");
-  EXPECT(&s, mark, "vec{3, 4}", "assignment echoes the value");
+  EXPECT(&s, mark, "dm> ", "assignment accepted");
+  mark = s.len;
+  send(&s, "v\r");
+  EXPECT(&s, mark, "\nvec{3, 4}", "the value prints itself");
   mark = s.len;
   send(&s, "v:no\t");
   EXPECT(&s, mark, "v:norm", "v:no<TAB> completes a method of a userdata");
@@ -169,11 +172,18 @@ int main(void)
   mark = s.len;
   send(&s, "v:\t\t");
   EXPECT(&s, mark, "v:totable", "v:<TAB><TAB> lists the methods");
+  mark = (size_t)(strstr(s.buf + mark, "v:totable") - s.buf);
+  EXPECT(&s, mark, "dm> v:", "the line is redrawn after the list");
+  mark = s.len;
   send(&s, "\x03");
+  EXPECT(&s, mark, "dm> ", "Ctrl-C after a completion list clears the line");
   mark = s.len;
   send(&s, "string.for\t");
   EXPECT(&s, mark, "string.format", "completion through nested tables");
+  tap_ok(strstr(s.buf + mark, "v:string") == NULL, "nothing left of the cleared line");
+  mark = s.len;
   send(&s, "\x03");
+  EXPECT(&s, mark, "dm> ", "Ctrl-C again");
 
   mark = s.len;
   send(&s, "x = 2.385; while true do end\r");
@@ -192,6 +202,7 @@ int main(void)
   mark = s.len;
   send(&s, "print('again' .. 6 * 7)\r");
   EXPECT(&s, mark, "again42", "last entry runs");
+  mark = (size_t)(strstr(s.buf + mark, "again42") - s.buf);
   EXPECT(&s, mark, "dm> ", "prompt back");   /* ^D only counts at a prompt */
   send(&s, "\x04");                            /* Ctrl-D: end of input */
   tap_ok(finish(&s, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0,
