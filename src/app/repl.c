@@ -37,7 +37,9 @@
 #define HISTORY_KEEP 10000
 
 static int use_readline = 0;
+#ifdef HAVE_READLINE
 static char *history_path = NULL;
+#endif
 
 /* {======================================================================
  * line input: Readline (callback interface) or stdio
@@ -138,6 +140,9 @@ static int rl_getline(const char *prompt, char **line)
 }
 #endif
 
+static volatile sig_atomic_t stdio_sigint = 0;
+static void on_stdio_sigint(int sig) { (void)sig; stdio_sigint = 1; }
+
 static const char *get_prompt(lua_State *L, int firstline)
 {
   if (lua_getglobal(L, firstline ? "_PROMPT" : "_PROMPT2") == LUA_TNIL)
@@ -150,12 +155,12 @@ static const char *get_prompt(lua_State *L, int firstline)
 static int pushline(lua_State *L, int firstline)
 {
   const char *prompt;
-  char *b;
   size_t l;
   int top = lua_gettop(L);
   prompt = get_prompt(L, firstline);
 #ifdef HAVE_READLINE
   if (use_readline) {
+    char *b;
     int ok = rl_getline(prompt, &b);
     lua_settop(L, top);
     if (!ok)
@@ -170,16 +175,27 @@ static int pushline(lua_State *L, int firstline)
   {
     char buffer[MAXINPUT];
     luaL_Buffer lb;
+    struct sigaction sa, old;
+    int r = 1;
     fputs(prompt, stdout);
     fflush(stdout);
     lua_settop(L, top);
+    /* On a terminal without Readline, Ctrl-C abandons the line: the read is
+     * interrupted (no SA_RESTART) and reported as a cancelled line. */
+    memset(&sa, 0, sizeof sa);
+    sigemptyset(&sa.sa_mask);
+    sa.sa_handler = on_stdio_sigint;
+    stdio_sigint = 0;
+    sigaction(SIGINT, &sa, &old);
     luaL_buffinit(L, &lb);
     for (;;) {
       if (fgets(buffer, sizeof buffer, stdin) == NULL) {
-        if (luaL_bufflen(&lb) == 0) {
-          luaL_pushresult(&lb);
-          lua_pop(L, 1);
-          return 0;
+        if (stdio_sigint) {
+          clearerr(stdin);
+          fputs("\n", stdout);
+          r = -1;
+        } else if (luaL_bufflen(&lb) == 0) {
+          r = 0;
         }
         break;
       }
@@ -190,8 +206,11 @@ static int pushline(lua_State *L, int firstline)
       }
       luaL_addlstring(&lb, buffer, l);
     }
+    sigaction(SIGINT, &old, NULL);
     luaL_pushresult(&lb);
-    return 1;
+    if (r != 1)
+      lua_pop(L, 1);
+    return r;
   }
 }
 
