@@ -1,0 +1,476 @@
+/* routh_compile.c -- the compiled side of a Routh reduction: the full,
+ * reduced and classical systems (dm_lagrangian_compile), the programs the
+ * reduced integrators evaluate, the public reduced system (forwarding to
+ * the compiled R^mu with `data` = the dm_routh, so the "routh" integrator
+ * family can find the connection data), accessors, mu and parameter
+ * updates, evaluation, and small numerical helpers. */
+#include <config.h>
+#include "routh_impl.h"
+#include "core/lagrangian.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_permutation.h>
+
+/* {==== programs ========================================================= */
+
+static int prog_compile(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *sp, dm_rprog *p,
+                        size_t nout, const dm_expr *out, size_t nin, const dm_expr *in,
+                        dm_err *e)
+{
+  dm_expr par[64 + DM_ROUTH_RMAX];
+  dm_expr *pp = par;
+  int st;
+  size_t i;
+  if (red->np > sizeof par / sizeof par[0] && (pp = malloc(red->np * sizeof *pp)) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  for (i = 0; i < red->npar; i++)
+    pp[i] = sp->par[i];
+  for (i = 0; i < red->r; i++)
+    pp[red->npar + i] = red->ex.mu[i];
+  st = dm_tape_compile(ctx, nout, out, nin, in, red->np, pp, &p->tape, e);
+  if (pp != par)
+    free(pp);
+  if (st != DM_OK)
+    return st;
+  p->nin = nin;
+  p->nout = nout;
+  p->nwork = dm_tape_work_size(p->tape);
+  if (p->nwork > red->nwork)
+    red->nwork = p->nwork;
+  if (sp->native != DM_NATIVE_NEVER) {
+    dm_err ne;
+    st = dm_native_compile(p->tape, NULL, red->par, &p->nat, &ne);
+    if (st == DM_OK)
+      p->fn = dm_native_function(p->nat);
+    else if (sp->native == DM_NATIVE_ALWAYS || st == DM_EINTR) {
+      if (e)
+        *e = ne;
+      return st;
+    }
+  }
+  return DM_OK;
+}
+
+static void prog_free(dm_rprog *p)
+{
+  dm_native_free(p->nat);
+  dm_tape_free(p->tape);
+  memset(p, 0, sizeof *p);
+}
+
+void dm_routh_release_progs(dm_routh *red)
+{
+  dm_rprog *ps[] = {&red->inertia, &red->conn, &red->connd, &red->gyro_r, &red->gyro_j,
+                    &red->thd, &red->info};
+  size_t i;
+  for (i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    prog_free(ps[i]);
+}
+
+/* {==== forwarding callbacks of the public reduced system ================ */
+
+int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
+                         unsigned what, dm_lag_out *out, void *work)
+{
+  const dm_routh *red = data;
+  return red->rsys.lagrangian(red->rsys.data, q, v, par, what, out, work);
+}
+
+static int force_forward(void *data, const double *q, const double *v, const double *par,
+                         unsigned what, double *F, double *Fq, double *Fv, void *work)
+{
+  const dm_routh *red = data;
+  return red->rsys.force(red->rsys.data, q, v, par, what, F, Fq, Fv, work);
+}
+
+static int constr_forward(void *data, const double *q, const double *par, unsigned what,
+                          double *g, double *G, double *H, void *work)
+{
+  const dm_routh *red = data;
+  return red->rsys.constraints(red->rsys.data, q, par, what, g, G, H, work);
+}
+
+/* {==== building ========================================================= */
+
+static int compile_system(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *sp, dm_expr L,
+                          const char *suffix, dm_system *sys, dm_err *e)
+{
+  dm_lagrangian_spec ls;
+  dm_expr *par = malloc(red->np * sizeof *par);
+  char name[512];
+  int st;
+  size_t i;
+  if (par == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  for (i = 0; i < red->npar; i++)
+    par[i] = sp->par[i];
+  for (i = 0; i < red->r; i++)
+    par[red->npar + i] = red->ex.mu[i];
+  snprintf(name, sizeof name, "%s%s", red->name, suffix);
+  memset(&ls, 0, sizeof ls);
+  ls.name = name;
+  ls.n = red->s;
+  ls.q = red->ex.x;
+  ls.v = red->ex.xdot;
+  ls.npar = red->np;
+  ls.par = par;
+  ls.par_values = red->par;
+  ls.coord_names = (const char *const *)red->names;
+  ls.param_names = (const char *const *)red->names + red->s;
+  ls.L = L;
+  ls.force = red->ex.force;
+  ls.m = red->m;
+  ls.constraints = red->ex.constraints;
+  ls.native = sp->native;
+  st = dm_lagrangian_compile(ctx, &ls, sys, e);
+  free(par);
+  return st;
+}
+
+static int compile_full(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_system *sys, dm_err *e)
+{
+  dm_lagrangian_spec ls;
+  memset(&ls, 0, sizeof ls);
+  ls.name = sp->name ? sp->name : "system";
+  ls.n = sp->n;
+  ls.q = sp->q;
+  ls.v = sp->v;
+  ls.npar = sp->npar;
+  ls.par = sp->par;
+  ls.par_values = sp->par_values;
+  ls.coord_names = sp->coord_names;
+  ls.param_names = sp->param_names;
+  ls.L = sp->L;
+  ls.force = sp->force;
+  ls.m = sp->m;
+  ls.constraints = sp->constraints;
+  ls.native = sp->native;
+  return dm_lagrangian_compile(ctx, &ls, sys, e);
+}
+
+int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec *sp,
+                           const dm_expr *K, const dm_expr *kv, const dm_expr *ib,
+                           const dm_expr *dkv, const dm_expr *dib, const dm_expr *Dw,
+                           const dm_expr *DA, dm_err *e)
+{
+  const dm_routh_exprs *x = &red->ex;
+  size_t r = red->r, s = red->s, ss = s * s, nmax;
+  size_t ninfo = 2 * r * r + r * s + r + s + 2 * ss + r + 5;
+  dm_expr *in = NULL, *out = NULL;
+  int st;
+  nmax = ninfo > 3 * s + 4 * ss ? ninfo : 3 * s + 4 * ss;
+  if (r + r * s + s > nmax)
+    nmax = r + r * s + s;
+  if (r * s + r * ss > nmax)
+    nmax = r * s + r * ss;
+  in = malloc(2 * s * sizeof *in);
+  out = malloc(nmax * sizeof *out);
+  if (in == NULL || out == NULL) {
+    st = dm_err_set(e, DM_ENOMEM, "out of memory");
+    goto done;
+  }
+  memcpy(in, x->x, s * sizeof *in);
+  memcpy(in + s, x->xdot, s * sizeof *in);
+  if ((st = compile_full(ctx, sp, &red->fsys, e)) != DM_OK ||
+      (st = compile_system(ctx, red, sp, x->R, "", &red->rsys, e)) != DM_OK ||
+      (st = compile_system(ctx, red, sp, x->Rc, " (classical Routhian)", &red->csys, e)) != DM_OK)
+    goto done;
+  if ((st = prog_compile(ctx, red, sp, &red->inertia, r * r, x->I, s, in, e)) != DM_OK)
+    goto done;
+  memcpy(out, x->Iinv_mu, r * sizeof *out);
+  memcpy(out + r, x->A, r * s * sizeof *out);
+  memcpy(out + r + r * s, x->muA, s * sizeof *out);
+  if ((st = prog_compile(ctx, red, sp, &red->conn, r + r * s + s, out, s, in, e)) != DM_OK)
+    goto done;
+  memcpy(out, Dw, r * s * sizeof *out);
+  memcpy(out + r * s, DA, r * ss * sizeof *out);
+  if ((st = prog_compile(ctx, red, sp, &red->connd, r * s + r * ss, out, s, in, e)) != DM_OK)
+    goto done;
+  memcpy(out, x->muA, s * sizeof *out);
+  memcpy(out + s, kv, s * sizeof *out);
+  memcpy(out + 2 * s, ib, s * sizeof *out);
+  if ((st = prog_compile(ctx, red, sp, &red->gyro_r, 3 * s, out, 2 * s, in, e)) != DM_OK)
+    goto done;
+  /* gyro_j: muA, K, B, kv, ib, dkv, dib */
+  memcpy(out, x->muA, s * sizeof *out);
+  memcpy(out + s, K, ss * sizeof *out);
+  memcpy(out + s + ss, x->B, ss * sizeof *out);
+  memcpy(out + s + 2 * ss, kv, s * sizeof *out);
+  memcpy(out + 2 * s + 2 * ss, ib, s * sizeof *out);
+  memcpy(out + 3 * s + 2 * ss, dkv, ss * sizeof *out);
+  memcpy(out + 3 * s + 3 * ss, dib, ss * sizeof *out);
+  if ((st = prog_compile(ctx, red, sp, &red->gyro_j, 3 * s + 4 * ss, out, 2 * s, in, e)) != DM_OK)
+    goto done;
+  if ((st = prog_compile(ctx, red, sp, &red->thd, r, x->thetadot, 2 * s, in, e)) != DM_OK)
+    goto done;
+  /* info: I, Iinv, A, Iinv_mu, muA, Mt, B, thetadot, detI, V, Vmu, R, Rc */
+  {
+    dm_expr *o = out;
+    memcpy(o, x->I, r * r * sizeof *o); o += r * r;
+    memcpy(o, x->Iinv, r * r * sizeof *o); o += r * r;
+    memcpy(o, x->A, r * s * sizeof *o); o += r * s;
+    memcpy(o, x->Iinv_mu, r * sizeof *o); o += r;
+    memcpy(o, x->muA, s * sizeof *o); o += s;
+    memcpy(o, x->Mtilde, ss * sizeof *o); o += ss;
+    memcpy(o, x->B, ss * sizeof *o); o += ss;
+    memcpy(o, x->thetadot, r * sizeof *o); o += r;
+    *o++ = x->detI; *o++ = x->V; *o++ = x->Vmu; *o++ = x->R; *o++ = x->Rc;
+  }
+  if ((st = prog_compile(ctx, red, sp, &red->info, ninfo, out, 2 * s, in, e)) != DM_OK)
+    goto done;
+  /* the public reduced system */
+  red->sys = red->rsys;
+  red->sys.name = red->name;
+  red->sys.par = red->par;
+  red->sys.lagrangian = dm_routh_lag_forward;
+  red->sys.force = red->rsys.force ? force_forward : NULL;
+  red->sys.constraints = red->rsys.constraints ? constr_forward : NULL;
+  red->sys.data = red;
+  red->sys.free_data = NULL;
+  red->nscratch = 8 * red->n + 4 * red->n * red->n + ninfo + red->nwork + 2 * red->np
+                  + red->fsys.work_size / sizeof(double) + 1;
+  red->scratch = calloc(red->nscratch, sizeof(double));
+  if (red->scratch == NULL)
+    st = dm_err_set(e, DM_ENOMEM, "out of memory");
+done:
+  free(in);
+  free(out);
+  return st;
+}
+
+void dm_routh_free(dm_routh *red)
+{
+  size_t i;
+  if (red == NULL)
+    return;
+  dm_routh_release_progs(red);
+  dm_system_release(&red->fsys);
+  dm_system_release(&red->rsys);
+  dm_system_release(&red->csys);
+  for (i = 0; red->names && i < red->s + red->np; i++)
+    free(red->names[i]);
+  free(red->names);
+  free(red->name);
+  free(red->shape);
+  free(red->par);
+  free(red->exbuf);
+  free(red->scratch);
+  free(red);
+}
+
+/* {==== accessors ======================================================== */
+
+const dm_routh_exprs *dm_routh_exprs_get(const dm_routh *red) { return &red->ex; }
+const dm_system *dm_routh_system(const dm_routh *red) { return &red->sys; }
+const dm_system *dm_routh_classical(const dm_routh *red) { return &red->csys; }
+const dm_system *dm_routh_full(const dm_routh *red) { return &red->fsys; }
+const double *dm_routh_mu(const dm_routh *red) { return red->par + red->npar; }
+
+int dm_routh_of_system(const dm_system *sys, dm_routh **red)
+{
+  if (sys == NULL || sys->lagrangian != dm_routh_lag_forward || sys->data == NULL)
+    return 0;
+  if (red)
+    *red = sys->data;
+  return 1;
+}
+
+static void refresh(dm_routh *red)
+{
+  dm_lagrangian_refresh(&red->rsys, NULL);
+  dm_lagrangian_refresh(&red->csys, NULL);
+  red->sys.flags = red->rsys.flags;
+  red->sys.mass = red->rsys.mass;
+}
+
+int dm_routh_set_mu(dm_routh *red, const double *mu, dm_err *e)
+{
+  size_t a;
+  for (a = 0; a < red->r; a++)
+    if (!isfinite(mu[a]))
+      return dm_err_set(e, DM_EINVAL, "momentum mu[%zu] = %g is not finite", a + 1, mu[a]);
+  for (a = 0; a < red->r; a++) {
+    size_t k = red->npar + a;
+    red->par[k] = red->rsys.par[k] = red->csys.par[k] = mu[a];
+  }
+  refresh(red);
+  return DM_OK;
+}
+
+int dm_routh_set_param(dm_routh *red, size_t i, double v, dm_err *e)
+{
+  if (i >= red->npar)
+    return dm_err_set(e, DM_EINVAL, "parameter index %zu out of range 1..%zu", i + 1, red->npar);
+  red->par[i] = red->rsys.par[i] = red->csys.par[i] = red->fsys.par[i] = v;
+  dm_lagrangian_refresh(&red->fsys, NULL);
+  refresh(red);
+  return DM_OK;
+}
+
+int dm_routh_set_sing_tol(dm_routh *red, double tol, dm_err *e)
+{
+  if (!(tol > 0.0 && tol < 1.0))
+    return dm_err_set(e, DM_EINVAL, "sing_tol = %g must be in (0, 1)", tol);
+  red->sing_tol = tol;
+  return DM_OK;
+}
+
+static int finite_all(const double *x, size_t n)
+{
+  size_t i;
+  for (i = 0; i < n; i++)
+    if (!isfinite(x[i]))
+      return 0;
+  return 1;
+}
+
+int dm_routh_eval(dm_routh *red, const double *x, const double *xdot, dm_routh_vals *v,
+                  dm_err *e)
+{
+  size_t r = red->r, s = red->s, ss = s * s;
+  double *in = red->scratch, *o = in + 2 * s, *w = o + red->info.nout;
+  memcpy(in, x, s * sizeof *in);
+  if (xdot)
+    memcpy(in + s, xdot, s * sizeof *in);
+  else
+    memset(in + s, 0, s * sizeof *in);
+  dm_rprog_run(&red->info, in, red->par, o, w);
+  if (!finite_all(o, red->info.nout))
+    return dm_err_set(e, DM_EDOM, "the reduced objects are not finite at this point (singular "
+                      "locked inertia or outside the domain)");
+#define PUT(f, k) do { if (v->f) memcpy(v->f, o, (k) * sizeof *o); o += (k); } while (0)
+  PUT(I, r * r); PUT(Iinv, r * r); PUT(A, r * s); PUT(Iinv_mu, r); PUT(muA, s);
+  PUT(Mtilde, ss); PUT(B, ss); PUT(thetadot, r);
+#undef PUT
+  v->detI = o[0];
+  v->V = o[1];
+  v->Vmu = o[2];
+  v->R = o[3];
+  v->Rc = o[4];
+  return DM_OK;
+}
+
+/* {==== small numerical helpers ========================================== */
+
+void dm_routh_sym_eig(const double *I, size_t r, double *lmin, double *lmax)
+{
+  double a[9], lo, hi;
+  size_t i, j, p, q, sweep;
+  if (r == 1) {
+    *lmin = *lmax = I[0];
+    return;
+  }
+  if (r == 2) {
+    double m = 0.5 * (I[0] + I[3]), d = 0.5 * (I[0] - I[3]);
+    double rad = hypot(d, 0.5 * (I[1] + I[2]));
+    *lmin = m - rad;
+    *lmax = m + rad;
+    return;
+  }
+  /* 3 x 3: cyclic Jacobi rotations (quadratic convergence) */
+  for (i = 0; i < 9; i++)
+    a[i] = I[i];
+  for (i = 0; i < 3; i++)
+    for (j = 0; j < i; j++)
+      a[i * 3 + j] = a[j * 3 + i] = 0.5 * (a[i * 3 + j] + a[j * 3 + i]);
+  for (sweep = 0; sweep < 30; sweep++) {
+    double off = fabs(a[1]) + fabs(a[2]) + fabs(a[5]);
+    if (off <= 1e-300 || off <= DBL_EPSILON * 1e-3 * (fabs(a[0]) + fabs(a[4]) + fabs(a[8])))
+      break;
+    for (p = 0; p < 2; p++)
+      for (q = p + 1; q < 3; q++) {
+        double apq = a[p * 3 + q], th, t, c, sn;
+        size_t k;
+        if (apq == 0.0)
+          continue;
+        th = (a[q * 3 + q] - a[p * 3 + p]) / (2.0 * apq);
+        t = (th >= 0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+        c = 1.0 / sqrt(t * t + 1.0);
+        sn = t * c;
+        for (k = 0; k < 3; k++) {     /* columns p, q */
+          double akp = a[k * 3 + p], akq = a[k * 3 + q];
+          a[k * 3 + p] = c * akp - sn * akq;
+          a[k * 3 + q] = sn * akp + c * akq;
+        }
+        for (k = 0; k < 3; k++) {     /* rows p, q */
+          double apk = a[p * 3 + k], aqk = a[q * 3 + k];
+          a[p * 3 + k] = c * apk - sn * aqk;
+          a[q * 3 + k] = sn * apk + c * aqk;
+        }
+      }
+  }
+  lo = fmin(a[0], fmin(a[4], a[8]));
+  hi = fmax(a[0], fmax(a[4], a[8]));
+  *lmin = lo;
+  *lmax = hi;
+}
+
+int dm_rlu_init(dm_rlu *lu, size_t N)
+{
+  lu->N = N;
+  lu->perm = N ? gsl_permutation_alloc(N) : NULL;
+  return N == 0 || lu->perm != NULL ? DM_OK : DM_ENOMEM;
+}
+
+void dm_rlu_free(dm_rlu *lu)
+{
+  if (lu->perm)
+    gsl_permutation_free(lu->perm);
+  lu->perm = NULL;
+}
+
+int dm_rlu_factor(dm_rlu *lu, double *a, size_t N)
+{
+  gsl_matrix_view M = gsl_matrix_view_array(a, N, N);
+  double amax = dm_rnorm_inf(a, N * N), umin = HUGE_VAL;
+  int sg;
+  size_t i;
+  if (N != lu->N)
+    return DM_EINVAL;
+  if (!isfinite(amax))
+    return DM_EDOM;
+  if (gsl_linalg_LU_decomp(&M.matrix, lu->perm, &sg) != GSL_SUCCESS)
+    return DM_ESINGULAR;
+  for (i = 0; i < N; i++)
+    umin = fmin(umin, fabs(a[i * N + i]));
+  if (!(umin > 16.0 * (double)N * DBL_EPSILON * amax))
+    return DM_ESINGULAR;
+  return DM_OK;
+}
+
+void dm_rlu_solve(const dm_rlu *lu, const double *a, size_t N, double *rhs)
+{
+  gsl_matrix_const_view M = gsl_matrix_const_view_array(a, N, N);
+  gsl_vector_view b = gsl_vector_view_array(rhs, N);
+  gsl_linalg_LU_svx(&M.matrix, lu->perm, &b.vector);
+}
+
+double dm_rnorm_inf(const double *x, size_t n)
+{
+  double m = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++) {
+    double a = fabs(x[i]);
+    if (a > m || a != a)
+      m = a;
+  }
+  return m;
+}
+
+const char *dm_rfmt_vec(char *buf, size_t len, const double *x, size_t n)
+{
+  size_t k = 0, i;
+  if (len == 0)
+    return buf;
+  buf[0] = '\0';
+  k += (size_t)snprintf(buf + k, len - k, "(");
+  for (i = 0; i < n && i < 6 && k < len; i++)
+    k += (size_t)snprintf(buf + k, len - k, "%s%.6g", i ? ", " : "", x[i]);
+  if (k < len)
+    snprintf(buf + k, len - k, "%s)", n > 6 ? ", ..." : "");
+  return buf;
+}

@@ -1,0 +1,119 @@
+/* routh_impl.h -- private state of the Routh reduction, shared by the files
+ * of src/reduce (not part of the public API). */
+#ifndef DM_ROUTH_IMPL_H
+#define DM_ROUTH_IMPL_H
+
+#include "routh.h"
+#include "core/tape.h"
+
+/* A compiled bundle of outputs: tape, and native code when available. */
+typedef struct dm_rprog {
+  dm_tape *tape;
+  dm_native *nat;
+  dm_native_fn fn;
+  size_t nin, nout, nwork;   /* nwork: tape work doubles */
+} dm_rprog;
+
+static inline void dm_rprog_run(const dm_rprog *p, const double *in, const double *par,
+                                double *out, double *work)
+{
+  if (p->fn)
+    p->fn(in, par, out);
+  else
+    dm_tape_eval(p->tape, in, par, out, work);
+}
+
+struct dm_routh {
+  char *name;
+  size_t n, r, s, m, npar, np;     /* np = npar + r */
+  size_t cyc[DM_ROUTH_RMAX];
+  size_t *shape;                   /* s */
+  int has_gyro;                    /* mu^T A not identically zero */
+  int has_force;
+  double sing_tol;
+  double *par;                     /* np: original params, then mu */
+  char **names;                    /* s shape names + np param names */
+  dm_system fsys, rsys, csys;      /* compiled full, reduced R, classical Rc */
+  dm_system sys;                   /* the public reduced system (forwards to rsys) */
+  dm_routh_exprs ex;
+  dm_expr *exbuf;                  /* storage of the node arrays of ex */
+  size_t *idxbuf;
+  /* programs (inputs x, or (x, xdot); params par) */
+  dm_rprog inertia;                /* x -> I (r*r) */
+  dm_rprog conn;                   /* x -> Iinv_mu (r), A (r*s), muA (s) */
+  dm_rprog connd;                  /* x -> D Iinv_mu (r*s), D A (r*s*s: [a][i][k] = dA_ai/dx_k) */
+  dm_rprog gyro_r;                 /* (x, xd) -> muA, kv, ib */
+  dm_rprog gyro_j;                 /* (x, xd) -> muA, K, B, kv, ib, dkv/dx, dib/dx */
+  dm_rprog thd;                    /* (x, xd) -> thetadot (r) */
+  dm_rprog info;                   /* (x, xd) -> everything of dm_routh_vals */
+  size_t nwork;                    /* max tape work over the programs */
+  double *scratch;                 /* for the evaluation helpers */
+  size_t nscratch;
+};
+
+/* routh_compile.c: compile the systems and programs from the derived nodes
+ * (red->ex) and the internal ones: K = d muA/dx (s*s), kv = K xdot, ib =
+ * i_xdot B (s each), their x-Jacobians dkv, dib (s*s), Dw = d(I^{-1} mu)/dx
+ * (r*s), DA (r*s*s). */
+int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec *sp,
+                           const dm_expr *K, const dm_expr *kv, const dm_expr *ib,
+                           const dm_expr *dkv, const dm_expr *dib, const dm_expr *Dw,
+                           const dm_expr *DA, dm_err *e);
+void dm_routh_release_progs(dm_routh *red);
+int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
+                         unsigned what, dm_lag_out *out, void *work);
+
+/* Smallest and largest eigenvalue of the symmetric r x r matrix I (r <= 3;
+ * closed form / Jacobi sweeps, no allocation). */
+void dm_routh_sym_eig(const double *I, size_t r, double *lmin, double *lmax);
+
+/* Gather / scatter between full coordinates and (theta, x). */
+static inline void dm_routh_split(const dm_routh *red, const double *q, double *theta, double *x)
+{
+  size_t a, i;
+  for (a = 0; theta && a < red->r; a++)
+    theta[a] = q[red->cyc[a]];
+  for (i = 0; x && i < red->s; i++)
+    x[i] = q[red->shape[i]];
+}
+
+static inline void dm_routh_join(const dm_routh *red, const double *theta, const double *x,
+                                 double *q)
+{
+  size_t a, i;
+  for (a = 0; a < red->r; a++)
+    q[red->cyc[a]] = theta ? theta[a] : 0.0;
+  for (i = 0; i < red->s; i++)
+    q[red->shape[i]] = x[i];
+}
+
+/* Small dense LU with partial pivoting on a row-major N x N matrix (GSL);
+ * DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
+typedef struct dm_rlu {
+  size_t N;
+  void *perm;                      /* gsl_permutation */
+} dm_rlu;
+int dm_rlu_init(dm_rlu *lu, size_t N);
+void dm_rlu_free(dm_rlu *lu);
+int dm_rlu_factor(dm_rlu *lu, double *a, size_t N);
+void dm_rlu_solve(const dm_rlu *lu, const double *a, size_t N, double *rhs);
+
+double dm_rnorm_inf(const double *x, size_t n);
+const char *dm_rfmt_vec(char *buf, size_t len, const double *x, size_t n);
+
+/* Galerkin discrete Lagrangian of a (full, unconstrained, unforced) system:
+ * boundary problem for (V, p0) given (q0, q1); derivatives of p0, p1 with
+ * respect to q0 and q1 by implicit differentiation (galerkin_ld.c). */
+typedef struct dm_gld dm_gld;
+int dm_gld_alloc(const dm_system *sys, const dm_tableau *t, double tol, int maxiter,
+                 dm_gld **out, dm_err *e);
+void dm_gld_free(dm_gld *g);
+/* p0 = -D1 Ld, p1 = D2 Ld, Ld; with deriv != 0 also the n x n blocks
+ * dp0/dq0, dp0/dq1, dp1/dq0, dp1/dq1 (row-major, into d00, d01, d10, d11).
+ * The stage velocities of the last solve seed the next one when warm != 0. */
+int dm_gld_solve(dm_gld *g, double h, const double *q0, const double *q1, double *p0,
+                 double *p1, double *Ld, int deriv, double *d00, double *d01, double *d10,
+                 double *d11, int warm, dm_err *e);
+int dm_gld_iters(const dm_gld *g);
+
+#endif
