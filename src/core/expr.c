@@ -184,6 +184,11 @@ static dm_expr cons(dm_expr_ctx *ctx, int op, int32_t a, int32_t b, int32_t c)
   return (dm_expr)ctx->n++;
 }
 
+dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c)
+{
+  return cons(ctx, op, a, b, c);
+}
+
 /* The existing node (op, a, b, c) or DM_EXPR_NONE (not for CONST). */
 static dm_expr find(const dm_expr_ctx *ctx, int op, int32_t a, int32_t b,
                     int32_t c)

@@ -60,12 +60,11 @@ static int cmp_i32(const void *x, const void *y)
   return (a > b) - (a < b);
 }
 
-typedef int (*stop_fn)(const dm_expr_ctx *ctx, dm_expr e, const void *data);
 
 /* Reachable nodes from roots, not descending below nodes where stop()
  * says so (they are still collected). */
 static long collect(dm_expr_ctx *ctx, size_t nroot, const dm_expr *roots,
-                    stop_fn stop, const void *data)
+                    dm_expr__stop_fn stop, const void *data)
 {
   if (scratch_reserve(ctx) != 0)
     return -1;
@@ -116,10 +115,22 @@ long dm_expr__collect(dm_expr_ctx *ctx, size_t n, const dm_expr *roots)
   return collect(ctx, n, roots, NULL, NULL);
 }
 
+long dm_expr__collect_stop(dm_expr_ctx *ctx, size_t n, const dm_expr *roots,
+                           dm_expr__stop_fn stop, const void *data)
+{
+  return collect(ctx, n, roots, stop, data);
+}
+
+
 static int no_vars(const dm_expr_ctx *ctx, dm_expr e, const void *data)
 {
   (void)data;
   return (ctx->node[e].flags & (DM_NF_SYM | DM_NF_PARAM)) == 0;
+}
+
+long dm_expr__collect_vars(dm_expr_ctx *ctx, size_t n, const dm_expr *roots)
+{
+  return collect(ctx, n, roots, no_vars, NULL);
 }
 
 int dm_expr_depends(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars)
@@ -168,7 +179,7 @@ static size_t memo_slot(int32_t node, int32_t var, size_t mask)
   return (size_t)h & mask;
 }
 
-static int32_t memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var)
+int32_t dm_expr__memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var)
 {
   if (ctx->memocap == 0)
     return -1;
@@ -180,7 +191,7 @@ static int32_t memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var)
   return -1;
 }
 
-static int memo_put(dm_expr_ctx *ctx, int32_t node, int32_t var, int32_t res)
+int dm_expr__memo_put(dm_expr_ctx *ctx, int32_t node, int32_t var, int32_t res)
 {
   if (2 * (ctx->nmemo + 1) > ctx->memocap) {
     size_t cap = ctx->memocap ? 2 * ctx->memocap : 1024;
@@ -221,7 +232,7 @@ struct dstop { int32_t var; };
 static int diff_stop(const dm_expr_ctx *ctx, dm_expr e, const void *data)
 {
   const struct dstop *d = data;
-  return no_vars(ctx, e, NULL) || memo_get(ctx, e, d->var) >= 0;
+  return no_vars(ctx, e, NULL) || dm_expr__memo_get(ctx, e, d->var) >= 0;
 }
 
 /* The derivative of node e given the derivatives of its operands (aux). */
@@ -344,7 +355,7 @@ dm_expr dm_expr_diff(dm_expr_ctx *ctx, dm_expr e, dm_expr var)
     return DM_EXPR_NONE;
   if (no_vars(ctx, e, NULL))
     return zero;
-  int32_t r = memo_get(ctx, e, var);
+  int32_t r = dm_expr__memo_get(ctx, e, var);
   if (r >= 0)
     return r;
   struct dstop st = { var };
@@ -359,12 +370,12 @@ dm_expr dm_expr_diff(dm_expr_ctx *ctx, dm_expr e, dm_expr var)
       ctx->aux[x] = zero;
       continue;
     }
-    int32_t m = memo_get(ctx, x, var);
+    int32_t m = dm_expr__memo_get(ctx, x, var);
     if (m < 0) {
       m = diff_node(ctx, x, var, zero, one);
       if (m == DM_EXPR_NONE)
         return DM_EXPR_NONE;
-      if (memo_put(ctx, x, var, m) != 0)
+      if (dm_expr__memo_put(ctx, x, var, m) != 0)
         return dm_expr__fail(ctx, DM_ENOMEM, "expression: out of memory");
     }
     ctx->aux[x] = m;
@@ -372,20 +383,11 @@ dm_expr dm_expr_diff(dm_expr_ctx *ctx, dm_expr e, dm_expr var)
   return ctx->aux[e];
 }
 
-static int ctx_status(dm_expr_ctx *ctx, dm_err *err)
+int dm_expr__status(dm_expr_ctx *ctx, dm_err *err)
 {
   if (err != NULL && ctx->err.status != DM_OK)
     *err = ctx->err;
   return ctx->err.status != DM_OK ? ctx->err.status : DM_EFAILED;
-}
-
-int dm_expr_grad(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
-                 dm_expr *grad, dm_err *err)
-{
-  for (size_t i = 0; i < n; i++)
-    if ((grad[i] = dm_expr_diff(ctx, e, vars[i])) == DM_EXPR_NONE)
-      return ctx_status(ctx, err);
-  return DM_OK;
 }
 
 int dm_expr_jacobian(dm_expr_ctx *ctx, size_t m, const dm_expr *f, size_t n,
@@ -395,21 +397,6 @@ int dm_expr_jacobian(dm_expr_ctx *ctx, size_t m, const dm_expr *f, size_t n,
     int s = dm_expr_grad(ctx, f[i], n, vars, J + i * n, err);
     if (s != DM_OK)
       return s;
-  }
-  return DM_OK;
-}
-
-int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
-                    dm_expr *H, dm_err *err)
-{
-  for (size_t i = 0; i < n; i++) {
-    dm_expr gi = dm_expr_diff(ctx, e, vars[i]);
-    for (size_t j = i; j < n; j++) {
-      dm_expr h = dm_expr_diff(ctx, gi, vars[j]);
-      if (h == DM_EXPR_NONE)
-        return ctx_status(ctx, err);
-      H[i * n + j] = H[j * n + i] = h;
-    }
   }
   return DM_OK;
 }
@@ -475,7 +462,7 @@ int dm_expr_subs(dm_expr_ctx *ctx, size_t ne, const dm_expr *e, dm_expr *out,
       continue;
     dm_expr y = rebuild(ctx, x);
     if (y == DM_EXPR_NONE)
-      return ctx_status(ctx, err);
+      return dm_expr__status(ctx, err);
     ctx->aux[x] = y;
   }
   for (size_t k = 0; k < ne; k++)

@@ -70,4 +70,35 @@ static inline int dm_expr__arity(int op)
  * aux[] of those nodes is free for the caller. */
 long dm_expr__collect(dm_expr_ctx *ctx, size_t n, const dm_expr *roots);
 
+/* Same, not descending below nodes where stop() is true. */
+typedef int (*dm_expr__stop_fn)(const dm_expr_ctx *ctx, dm_expr e,
+                                const void *data);
+long dm_expr__collect_stop(dm_expr_ctx *ctx, size_t n, const dm_expr *roots,
+                           dm_expr__stop_fn stop, const void *data);
+
+/* Same, not descending into subtrees without symbols or parameters. */
+long dm_expr__collect_vars(dm_expr_ctx *ctx, size_t n, const dm_expr *roots);
+
+/* Derivative memo: the result for (node, var) or -1; store one. */
+int32_t dm_expr__memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var);
+int dm_expr__memo_put(dm_expr_ctx *ctx, int32_t node, int32_t var, int32_t res);
+
+/* The node (op, a, b, c) exactly, without simplification (not CONST;
+ * unused operands -1). */
+dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c);
+
+/* The context's error status copied into err (DM_EFAILED if none). */
+int dm_expr__status(dm_expr_ctx *ctx, dm_err *err);
+
+/* Derivative memo: the result for (node, var) or -1; store one. */
+int32_t dm_expr__memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var);
+int dm_expr__memo_put(dm_expr_ctx *ctx, int32_t node, int32_t var, int32_t res);
+
+/* The node (op, a, b, c) exactly, without simplification (not CONST;
+ * unused operands -1). */
+dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c);
+
+/* The context's error status copied into err (DM_EFAILED if none). */
+int dm_expr__status(dm_expr_ctx *ctx, dm_err *err);
+
 #endif

@@ -5,6 +5,7 @@
 #include "lagrangian.h"
 #include "tape.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,7 +18,7 @@ typedef struct prog {
   dm_tape *tape;
   dm_native *nat;
   dm_native_fn fn;
-  size_t nout;
+  size_t nout, nregs;
 } prog;
 
 typedef struct lag_data {
@@ -65,22 +66,33 @@ static void lag_free(dm_system *s)
   s->data = NULL;
 }
 
-static inline void prog_run(const prog *p, const double *in, const double *par,
-                            double *out, double *tw)
+/* Inputs are written straight into the tape's register file (its first
+ * registers are the inputs), so neither path copies them twice; outputs
+ * go after the registers. */
+static inline double *prog_run(const prog *p, double *w, const double *par)
 {
+  double *o = w + p->nregs;
   if (p->fn != NULL)
-    p->fn(in, par, out);
+    p->fn(w, par, o);
   else
-    dm_tape_eval(p->tape, in, par, out, tw);
+    dm_tape_eval(p->tape, w, par, o, w);
+  return o;
 }
 
-/* 1 if any of x[0..k) is NaN or infinite. */
+static inline void copy(double *dst, const double *src, size_t k)
+{
+  for (size_t i = 0; i < k; i++)
+    dst[i] = src[i];
+}
+
+/* 1 if any of x[0..k) is NaN or infinite (independent tests, no serial
+ * chain: this runs after every evaluation). */
 static int nonfinite(const double *x, size_t k)
 {
-  double s = 0;
+  int bad = 0;
   for (size_t i = 0; i < k; i++)
-    s += x[i] * 0;          /* 0 unless some x[i] is NaN or Inf */
-  return isnan(s);
+    bad |= !(fabs(x[i]) <= DBL_MAX);
+  return bad;
 }
 
 /* Copy a packed upper triangle into a full symmetric n*n matrix. */
@@ -102,20 +114,19 @@ static int lag_eval(void *data, const double *q, const double *v,
                     void *work)
 {
   const lag_data *d = data;
-  size_t n = d->n;
-  double *in = work, *o = in + 2 * n;
+  const size_t n = d->n;
   const prog *p = (what & ~(unsigned)DM_LAG_GRAD) ? &d->all : &d->grad;
-  memcpy(in, q, n * sizeof *in);
-  memcpy(in + n, v, n * sizeof *in);
-  prog_run(p, in, par, o, o + p->nout);
+  double *w = work;
+  copy(w, q, n);
+  copy(w + n, v, n);
+  const double *o = prog_run(p, w, par);
   if (nonfinite(o, p->nout))
     return 1;               /* outside the domain: retry with another step */
-  if (what & DM_LAG_L)
-    out->L = o[0];
+  out->L = o[0];
   if (what & DM_LAG_Q)
-    memcpy(out->Lq, o + 1, n * sizeof *o);
+    copy(out->Lq, o + 1, n);
   if (what & DM_LAG_V)
-    memcpy(out->Lv, o + 1 + n, n * sizeof *o);
+    copy(out->Lv, o + 1 + n, n);
   if (p == &d->all) {
     const double *r = o + 1 + 2 * n;
     size_t tri = n * (n + 1) / 2;
@@ -123,7 +134,7 @@ static int lag_eval(void *data, const double *q, const double *v,
       unpack_sym(r, n, out->Lvv);
     r += tri;
     if (what & DM_LAG_VQ)
-      memcpy(out->Lvq, r, n * n * sizeof *r);
+      copy(out->Lvq, r, n * n);
     r += n * n;
     if (what & DM_LAG_QQ)
       unpack_sym(r, n, out->Lqq);
@@ -136,20 +147,20 @@ static int force_eval(void *data, const double *q, const double *v,
                       double *Fv, void *work)
 {
   const lag_data *d = data;
-  size_t n = d->n;
-  double *in = work, *o = in + 2 * n;
+  const size_t n = d->n;
   const prog *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
-  memcpy(in, q, n * sizeof *in);
-  memcpy(in + n, v, n * sizeof *in);
-  prog_run(p, in, par, o, o + p->nout);
+  double *w = work;
+  copy(w, q, n);
+  copy(w + n, v, n);
+  const double *o = prog_run(p, w, par);
   if (nonfinite(o, p->nout))
     return 1;
   if (what & DM_FORCE_F)
-    memcpy(F, o, n * sizeof *o);
+    copy(F, o, n);
   if (what & DM_FORCE_Q)
-    memcpy(Fq, o + n, n * n * sizeof *o);
+    copy(Fq, o + n, n * n);
   if (what & DM_FORCE_V)
-    memcpy(Fv, o + n + n * n, n * n * sizeof *o);
+    copy(Fv, o + n + n * n, n * n);
   return 0;
 }
 
@@ -158,16 +169,17 @@ static int constr_eval(void *data, const double *q, const double *par,
                        void *work)
 {
   const lag_data *d = data;
-  size_t n = d->n, m = d->m;
-  double *o = work;
+  const size_t n = d->n, m = d->m;
   const prog *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
-  prog_run(p, q, par, o, o + p->nout);
+  double *w = work;
+  copy(w, q, n);
+  const double *o = prog_run(p, w, par);
   if (nonfinite(o, p->nout))
     return 1;
   if (what & DM_CONSTR_G)
-    memcpy(g, o, m * sizeof *o);
+    copy(g, o, m);
   if (what & DM_CONSTR_DG)
-    memcpy(G, o + m, m * n * sizeof *o);
+    copy(G, o + m, m * n);
   if (what & DM_CONSTR_D2G) {
     const double *r = o + m + m * n;
     for (size_t a = 0; a < m; a++)
@@ -204,6 +216,7 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
   if (s != DM_OK)
     return s;
   p->nout = nout;
+  p->nregs = dm_tape_work_size(p->tape);
   if (sp->native == DM_NATIVE_NEVER)
     return DM_OK;
   dm_err nerr;
@@ -276,14 +289,15 @@ static int copy_names(lag_data *d, const dm_lagrangian_spec *sp,
  * definiteness (Cholesky).  Returns 1 when M is SPD. */
 static int eval_mass(lag_data *d)
 {
-  size_t n = d->n, nw = dm_tape_work_size(d->massp.tape);
-  double *buf = malloc((2 * n + n * n + nw) * sizeof *buf);
+  size_t n = d->n, nw = d->massp.nregs;
+  double *buf = calloc(nw + 2 * n * n + 1, sizeof *buf);
   if (buf == NULL)
     return 0;
-  memset(buf, 0, 2 * n * sizeof *buf);        /* q = v = 0: not read */
-  prog_run(&d->massp, buf, d->par, d->mass, buf + 2 * n + n * n);
-  memcpy(buf + 2 * n, d->mass, n * n * sizeof *buf);
-  gsl_matrix_view M = gsl_matrix_view_array(buf + 2 * n, n, n);
+  const double *M0 = prog_run(&d->massp, buf, d->par);  /* q = v = 0 */
+  memcpy(d->mass, M0, n * n * sizeof *buf);
+  double *A = buf + nw + n * n;
+  memcpy(A, M0, n * n * sizeof *buf);
+  gsl_matrix_view M = gsl_matrix_view_array(A, n, n);
   int spd = !nonfinite(d->mass, n * n) &&   /* needs dm_gsl_init() */
             gsl_linalg_cholesky_decomp1(&M.matrix) == GSL_SUCCESS;
   free(buf);
@@ -355,26 +369,32 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     dm_err_set(b->err, s, "out of memory");
     goto done;
   }
-  dm_expr *Lq = out + 1, *Lv = out + 1 + n, *o = out + 1 + 2 * n;
+  dm_expr *Lv = out + 1 + n, *o = out + 1 + 2 * n;
+  size_t m = 2 * n;
+  dm_expr *H = malloc(m * m * sizeof *H);
   out[0] = sp->L;
-  if (dm_expr_grad(b->ctx, sp->L, n, sp->q, Lq, NULL) != DM_OK ||
-      dm_expr_grad(b->ctx, sp->L, n, sp->v, Lv, NULL) != DM_OK) {
+  if (H == NULL) {
+    s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
+    goto done;
+  }
+  /* gradient and Hessian in (q, v) at once: the Hessian routine shares the
+   * chain rule through common subexpressions between all the blocks */
+  if (dm_expr_grad(b->ctx, sp->L, m, b->in, out + 1, NULL) != DM_OK ||
+      dm_expr_hessian(b->ctx, sp->L, m, b->in, H, NULL) != DM_OK) {
+    free(H);
     s = ctx_fail(b, "L");
     goto done;
   }
   for (size_t i = 0; i < n; i++)            /* Lvv, upper triangle */
     for (size_t j = i; j < n; j++)
-      *o++ = Lvv[i * n + j] = Lvv[j * n + i] = dm_expr_diff(b->ctx, Lv[i], sp->v[j]);
+      *o++ = Lvv[i * n + j] = Lvv[j * n + i] = H[(n + i) * m + n + j];
   for (size_t i = 0; i < n; i++)            /* Lvq, full */
     for (size_t j = 0; j < n; j++)
-      *o++ = Lvq[i * n + j] = dm_expr_diff(b->ctx, Lv[i], sp->q[j]);
+      *o++ = Lvq[i * n + j] = H[(n + i) * m + j];
   for (size_t i = 0; i < n; i++)            /* Lqq, upper triangle */
     for (size_t j = i; j < n; j++)
-      *o++ = dm_expr_diff(b->ctx, Lq[i], sp->q[j]);
-  if (dm_expr_ctx_err(b->ctx)->status != DM_OK) {
-    s = ctx_fail(b, "L");
-    goto done;
-  }
+      *o++ = H[i * m + j];
+  free(H);
   if ((s = compile_prog(b, &d->grad, 1 + 2 * n, out, 2 * n)) != DM_OK ||
       (s = compile_prog(b, &d->all, nall, out, 2 * n)) != DM_OK)
     goto done;
@@ -475,7 +495,7 @@ static int check_spec(builder *b)
 
 static size_t prog_need(const prog *p)
 {
-  return p->tape ? p->nout + dm_tape_work_size(p->tape) : 0;
+  return p->tape ? p->nregs + p->nout : 0;
 }
 
 int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
@@ -535,7 +555,7 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
   sys->force = sp->force ? force_eval : NULL;
   sys->constraints = sp->m ? constr_eval : NULL;
   sys->data = d;
-  sys->work_size = (2 * n + need) * sizeof(double);
+  sys->work_size = need * sizeof(double);
   sys->free_data = lag_free;
   free(b.in);
   free(b.in0);

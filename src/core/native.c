@@ -264,11 +264,14 @@ char *dm_native_source(const dm_tape *t)
     const dm_tape_ins *ip = &code[i];
     int op = (int)(ip->code & 0xff);
     operand(x, sizeof x, t, ip->a, writer);
+    int fused = op >= DM_T_MULADD && op <= DM_T_MUL3;
     if (op != DM_T_POWI && op != DM_T_SELECT && c_infix[op] == NULL &&
-        op != DM_T_POW && op != DM_T_ATAN2)
+        op != DM_T_POW && op != DM_T_ATAN2 && !fused)
       y[0] = '\0';
     else if (op != DM_T_POWI)
       operand(y, sizeof y, t, ip->b, writer);
+    if (fused)
+      operand(c, sizeof c, t, ip->code >> 8, writer);
     sb_printf(&b, "  const double t%zu = ", i);
     switch (op) {
     case DM_T_NEG: sb_printf(&b, "-%s;\n", x); break;
@@ -283,6 +286,10 @@ char *dm_native_source(const dm_tape *t)
       operand(c, sizeof c, t, ip->code >> 8, writer);
       sb_printf(&b, "%s != 0 ? %s : %s;\n", c, x, y);
       break;
+    case DM_T_MULADD: sb_printf(&b, "%s * %s + %s;\n", x, y, c); break;
+    case DM_T_MULSUB: sb_printf(&b, "%s * %s - %s;\n", x, y, c); break;
+    case DM_T_SUBMUL: sb_printf(&b, "%s - %s * %s;\n", c, x, y); break;
+    case DM_T_MUL3: sb_printf(&b, "%s * %s * %s;\n", x, y, c); break;
     default:
       if (c_infix[op] != NULL && op >= DM_T_LT)
         sb_printf(&b, "(%s %s %s) ? 1.0 : 0.0;\n", x, c_infix[op], y);

@@ -2,21 +2,14 @@
  * The evaluation loop is the hot path of every integrator: a switch over a
  * compact instruction array, no calls through pointers, no allocation. */
 #include <config.h>
-#include "tape.h"
+#include "tape_impl.h"
 #include "expr_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-struct dm_tape {
-  size_t nin, npar, nconst, nout, ninstr, nregs;
-  dm_tape_ins *code;
-  double *consts;
-  uint32_t *outreg;
-};
 
-#define BATCH 32            /* points per block in batch evaluation */
 
 void dm_tape_free(dm_tape *t)
 {
@@ -29,7 +22,7 @@ void dm_tape_free(dm_tape *t)
 }
 
 size_t dm_tape_work_size(const dm_tape *t) { return t->nregs; }
-size_t dm_tape_batch_work_size(const dm_tape *t) { return t->nregs * BATCH; }
+size_t dm_tape_batch_work_size(const dm_tape *t) { return t->nregs * DM_TAPE_BATCH; }
 size_t dm_tape_ninstr(const dm_tape *t) { return t->ninstr; }
 size_t dm_tape_nregs(const dm_tape *t) { return t->nregs; }
 size_t dm_tape_nin(const dm_tape *t) { return t->nin; }
@@ -53,7 +46,7 @@ const char *dm_tape_op_name(int op)
     "add", "sub", "mul", "div", "neg", "sqr", "cube", "recip", "powi", "pow",
     "atan2", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos",
     "atan", "sinh", "cosh", "tanh", "abs", "sign", "lt", "le", "gt", "ge",
-    "eq", "ne", "select"
+    "eq", "ne", "select", "muladd", "mulsub", "submul", "mul3"
   };
   return (op >= 0 && op < DM_T_NOPS) ? names[op] : "?";
 }
@@ -138,12 +131,80 @@ static int check_vars(dm_expr_ctx *ctx, size_t nin, const dm_expr *in,
   return DM_OK;
 }
 
+/* Divisions by a common denominator b become products with one shared
+ * reciprocal 1/b (a division costs several multiplications): out[] is
+ * rewritten into nw[] through unsimplified nodes. */
+static int share_reciprocals(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                             dm_expr *nw, dm_err *err)
+{
+  long nl = dm_expr__collect(ctx, nout, out);
+  if (nl < 0)
+    return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
+  size_t sz = (size_t)(nl ? nl : 1);
+  int32_t *L = malloc(sz * sizeof *L), *img = malloc(sz * sizeof *img);
+  if (L == NULL || img == NULL) {
+    free(L);
+    free(img);
+    return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
+  }
+  memcpy(L, ctx->list, sz * sizeof *L);
+  int32_t *uses = ctx->aux;               /* divisions by each node */
+  int any = 0;
+  for (long p = 0; p < nl; p++)
+    uses[L[p]] = 0;
+  for (long p = 0; p < nl; p++)
+    if (ctx->node[L[p]].op == DM_EXPR_DIV)
+      any |= ++uses[ctx->node[L[p]].b] >= 2;
+  int s = DM_OK;
+  dm_expr one = dm_expr_const(ctx, 1.0);
+  for (long p = 0; any && s == DM_OK && p < nl; p++) {
+    const dm_node nd = ctx->node[L[p]];
+    int k = dm_expr__arity(nd.op);
+    int32_t ops[3] = { nd.a, nd.b, nd.c }, nops[3] = { -1, -1, -1 };
+    int changed = 0;
+    for (int j = 0; j < k; j++) {         /* (POWI: b is the exponent) */
+      int32_t *hit = bsearch(&ops[j], L, (size_t)nl, sizeof *L, cmp_i32);
+      nops[j] = img[hit - L];
+      changed |= nops[j] != ops[j];
+    }
+    if (nd.op == DM_EXPR_POWI)
+      nops[1] = nd.b;
+    dm_expr y = L[p];
+    if (nd.op == DM_EXPR_DIV && uses[nd.b] >= 2 && !(nd.a == one)) {
+      dm_expr r = dm_expr__cons(ctx, DM_EXPR_DIV, one, nops[1], -1);
+      y = dm_expr__cons(ctx, DM_EXPR_MUL, nops[0], r, -1);
+    } else if (changed) {
+      y = dm_expr__cons(ctx, nd.op, nops[0], nops[1], nops[2]);
+    }
+    if (y == DM_EXPR_NONE)
+      s = dm_err_set(err, DM_ENOMEM, "tape: out of memory");
+    img[p] = y;
+  }
+  for (size_t k = 0; k < nout; k++) {
+    int32_t *hit = any ? bsearch(&out[k], L, (size_t)nl, sizeof *L, cmp_i32) : NULL;
+    nw[k] = hit ? img[hit - L] : out[k];
+  }
+  free(L);
+  free(img);
+  return s;
+}
+
+/* One planned instruction: its op and the list positions of its result
+ * and operands (-1: none; for POWI the exponent is in imm). */
+typedef struct plan {
+  int op;
+  int32_t pos, opnd[3], imm;
+} plan;
+
 typedef struct build {
   long nl;
   int32_t *list;        /* collected nodes (copy) */
-  int32_t *reg;         /* per position: register, or -1 for instructions */
+  int32_t *reg;         /* per position: register, -1 for results */
   int32_t *last;        /* per position: last instruction reading it */
-  int32_t *ins_pos;     /* per instruction: position of its node */
+  int32_t *uses;        /* per position: readers (outputs count) */
+  int32_t *planned;     /* per position: index into plans, -1 none */
+  plan *plans;
+  size_t nplans;
 } build;
 
 static void build_free(build *b)
@@ -151,53 +212,111 @@ static void build_free(build *b)
   free(b->list);
   free(b->reg);
   free(b->last);
-  free(b->ins_pos);
+  free(b->uses);
+  free(b->planned);
+  free(b->plans);
 }
 
-/* Allocate temporaries in instruction order, freeing each operand after its
- * last reading (so d may equal an operand: every op reads before writing). */
-static int assign_registers(dm_tape *t, const dm_expr_ctx *ctx, build *b,
-                            size_t base, dm_err *err)
+/* A plain product used by exactly one instruction and not an output can be
+ * folded into that instruction. */
+static int foldable(const build *b, int32_t q)
+{
+  int32_t k = b->planned[q];
+  return k >= 0 && b->plans[k].op == DM_T_MUL && b->uses[q] == 1;
+}
+
+/* Plan the instruction of the node at position p (operand positions from
+ * ctx->aux).  Products used once are folded into sums, differences and
+ * products (their plans become DM_T_NOPS: deleted). */
+static void plan_node(const dm_expr_ctx *ctx, build *b, long p)
+{
+  const dm_node nd = ctx->node[b->list[p]];
+  plan *pl = &b->plans[b->nplans];
+  int k = dm_expr__arity(nd.op);
+  int32_t ops[3] = { nd.a, nd.b, nd.c };
+  pl->pos = (int32_t)p;
+  pl->imm = nd.op == DM_EXPR_POWI ? nd.b : 0;
+  pl->opnd[0] = pl->opnd[1] = pl->opnd[2] = -1;
+  for (int j = 0; j < k; j++)
+    pl->opnd[j] = ctx->aux[ops[j]];
+  pl->op = lower(nd.op, nd.b);
+  double c1;
+  if (pl->op == DM_T_DIV && dm_expr_is_const(ctx, nd.a, &c1) && c1 == 1.0) {
+    pl->op = DM_T_RECIP;                      /* 1/b */
+    pl->opnd[0] = pl->opnd[1];
+    pl->opnd[1] = -1;
+  }
+  if (pl->op == DM_T_ADD || pl->op == DM_T_SUB || pl->op == DM_T_MUL) {
+    int32_t x = pl->opnd[0], y = pl->opnd[1], m = -1, other = -1;
+    int left = 0;
+    if (foldable(b, x) && x != y) {
+      m = x, other = y, left = 1;
+    } else if (foldable(b, y) && x != y) {
+      m = y, other = x;
+    }
+    if (m >= 0) {
+      plan *pm = &b->plans[b->planned[m]];
+      int op = pl->op == DM_T_ADD ? DM_T_MULADD : pl->op == DM_T_MUL ? DM_T_MUL3
+               : left ? DM_T_MULSUB : DM_T_SUBMUL;
+      pl->op = op;
+      pl->opnd[0] = pm->opnd[0];
+      pl->opnd[1] = pm->opnd[1];
+      pl->opnd[2] = other;
+      pm->op = DM_T_NOPS;                     /* folded away */
+      b->planned[m] = -1;
+    }
+  }
+  b->planned[p] = (int32_t)b->nplans++;
+}
+
+/* Temporaries by liveness: an operand's register is free after its last
+ * reading, so d may equal an operand (every op reads before writing). */
+static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
 {
   int32_t *freel = malloc((t->ninstr + 1) * sizeof *freel);
   if (freel == NULL)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  size_t nfree = 0, ntmp = 0;
-  for (size_t i = 0; i < t->ninstr; i++) {
-    long p = b->ins_pos[i];
-    const dm_node nd = ctx->node[b->list[p]];
-    int k = dm_expr__arity(nd.op);
-    int32_t ops[3] = { nd.a, nd.b, nd.c };
+  size_t nfree = 0, ntmp = 0, i = 0;
+  for (size_t k = 0; k < b->nplans; k++) {
+    const plan *pl = &b->plans[k];
+    if (pl->op == DM_T_NOPS)
+      continue;
     int32_t r[3] = { 0, 0, 0 };
-    for (int j = 0; j < k; j++) {
-      long q = ctx->aux[ops[j]];
+    for (int j = 0; j < 3; j++) {
+      int32_t q = pl->opnd[j];
+      if (q < 0)
+        continue;
       r[j] = b->reg[q];
-      if (b->last[q] == (int32_t)i && (size_t)r[j] >= base) {
-        int dup = 0;
-        for (int m = 0; m < j; m++)
-          dup |= ops[m] == ops[j];
-        if (!dup)
-          freel[nfree++] = r[j];
-      }
+      int dup = 0;
+      for (int m = 0; m < j; m++)
+        dup |= pl->opnd[m] == q;
+      if (b->last[q] == (int32_t)i && (size_t)r[j] >= base && !dup)
+        freel[nfree++] = r[j];
     }
     int32_t d = nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
-    b->reg[p] = d;
-    dm_tape_ins *ins = &t->code[i];
-    int op = lower(nd.op, nd.b);
+    b->reg[pl->pos] = d;
+    dm_tape_ins *ins = &t->code[i++];
     ins->d = (uint32_t)d;
-    ins->a = (uint32_t)r[0];
-    ins->b = op == DM_T_POWI ? (uint32_t)nd.b : (k >= 2 ? (uint32_t)r[1] : 0);
-    if (op == DM_T_SELECT) {        /* select(c, a, b): cond in code */
-      if ((uint32_t)r[0] >= (1u << 24)) {
-        free(freel);
-        return dm_err_set(err, DM_EUNSUP, "tape: too many registers");
-      }
-      ins->code = DM_T_SELECT | ((uint32_t)r[0] << 8);
+    switch (pl->op) {
+    case DM_T_SELECT:                         /* select(c, a, b) */
       ins->a = (uint32_t)r[1];
       ins->b = (uint32_t)r[2];
-    } else {
-      ins->code = (uint32_t)op;
+      r[2] = r[0];
+      break;
+    case DM_T_POWI:
+      ins->a = (uint32_t)r[0];
+      ins->b = (uint32_t)pl->imm;
+      break;
+    default:
+      ins->a = (uint32_t)r[0];
+      ins->b = (uint32_t)r[1];
+      break;
     }
+    if ((uint32_t)r[2] >= (1u << 24)) {
+      free(freel);
+      return dm_err_set(err, DM_EUNSUP, "tape: too many registers");
+    }
+    ins->code = (uint32_t)pl->op | (uint32_t)r[2] << 8;
   }
   free(freel);
   t->nregs = base + ntmp;
@@ -216,10 +335,13 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
   b->list = malloc(sz * sizeof *b->list);
   b->reg = malloc(sz * sizeof *b->reg);
   b->last = malloc(sz * sizeof *b->last);
-  b->ins_pos = malloc(sz * sizeof *b->ins_pos);
+  b->uses = calloc(sz, sizeof *b->uses);
+  b->planned = malloc(sz * sizeof *b->planned);
+  b->plans = malloc(sz * sizeof *b->plans);
   t->consts = malloc(sz * sizeof *t->consts);
   t->outreg = malloc((nout ? nout : 1) * sizeof *t->outreg);
-  if (!b->list || !b->reg || !b->last || !b->ins_pos || !t->consts || !t->outreg)
+  if (!b->list || !b->reg || !b->last || !b->uses || !b->planned ||
+      !b->plans || !t->consts || !t->outreg)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   memcpy(b->list, ctx->list, sz * sizeof *b->list);
   const uint32_t ep = ctx->epoch;
@@ -230,13 +352,14 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
     if (ctx->stamp[v] == ep)
       ctx->aux[v] = -2 - (int32_t)k;
   }
-  /* pass 1: positions, fixed registers, constants, instruction order */
-  size_t ncon = 0, nins = 0;
+  /* pass 1: positions, fixed registers, constants, use counts */
+  size_t ncon = 0;
   for (long p = 0; p < nl; p++) {
     int32_t x = b->list[p];
     const dm_node nd = ctx->node[x];
     b->last[p] = -1;
     b->reg[p] = -1;
+    b->planned[p] = -1;
     if (ctx->aux[x] <= -2) {
       b->reg[p] = -2 - ctx->aux[x];
     } else if (nd.op == DM_EXPR_CONST) {
@@ -250,10 +373,25 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
       int k = dm_expr__arity(nd.op);
       int32_t ops[3] = { nd.a, nd.b, nd.c };
       for (int j = 0; j < k; j++)
-        b->last[ctx->aux[ops[j]]] = (int32_t)nins;
-      b->ins_pos[nins++] = (int32_t)p;
+        b->uses[ctx->aux[ops[j]]]++;
     }
     ctx->aux[x] = (int32_t)p;
+  }
+  for (size_t k = 0; k < nout; k++)
+    b->uses[ctx->aux[out[k]]] += 2;            /* outputs are never folded */
+  /* pass 2: plan (folding products), then liveness over the plan */
+  b->nplans = 0;
+  for (long p = 0; p < nl; p++)
+    if (b->reg[p] == -1)
+      plan_node(ctx, b, p);
+  size_t nins = 0;
+  for (size_t k = 0; k < b->nplans; k++) {
+    if (b->plans[k].op == DM_T_NOPS)
+      continue;
+    for (int j = 0; j < 3; j++)
+      if (b->plans[k].opnd[j] >= 0)
+        b->last[b->plans[k].opnd[j]] = (int32_t)nins;
+    nins++;
   }
   size_t base = nin + npar + ncon;
   for (long p = 0; p < nl; p++)
@@ -269,7 +407,7 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
   t->code = malloc((nins ? nins : 1) * sizeof *t->code);
   if (t->code == NULL)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  int s = assign_registers(t, ctx, b, base, err);
+  int s = assign_registers(t, b, base, err);
   if (s != DM_OK)
     return s;
   for (size_t k = 0; k < nout; k++)
@@ -290,10 +428,17 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
   if (s != DM_OK)
     return s;
   dm_tape *t = calloc(1, sizeof *t);
-  build b = { 0, NULL, NULL, NULL, NULL };
-  if (t == NULL)
+  dm_expr *nw = malloc((nout ? nout : 1) * sizeof *nw);
+  build b = { 0, NULL, NULL, NULL, NULL, NULL, NULL, 0 };
+  if (t == NULL || nw == NULL) {
+    free(t);
+    free(nw);
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  s = compile(ctx, t, &b, nout, out, nin, in, npar, par, err);
+  }
+  s = share_reciprocals(ctx, nout, out, nw, err);
+  if (s == DM_OK)
+    s = compile(ctx, t, &b, nout, nw, nin, in, npar, par, err);
+  free(nw);
   build_free(&b);
   if (s != DM_OK) {
     dm_tape_free(t);
@@ -303,138 +448,3 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
   return DM_OK;
 }
 
-/* {==================================================================
- * evaluation
- * =================================================================== */
-
-static inline double sign_of(double x)
-{
-  return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;
-}
-
-void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
-                  double *out, double *w)
-{
-  if (t->nin)
-    memcpy(w, in, t->nin * sizeof *w);
-  if (t->npar)
-    memcpy(w + t->nin, par, t->npar * sizeof *w);
-  if (t->nconst)
-    memcpy(w + t->nin + t->npar, t->consts, t->nconst * sizeof *w);
-  const dm_tape_ins *ip = t->code, *end = ip + t->ninstr;
-  for (; ip < end; ip++) {
-    const double a = w[ip->a];
-    double *d = w + ip->d;
-    switch (ip->code & 0xff) {
-    case DM_T_ADD: *d = a + w[ip->b]; break;
-    case DM_T_SUB: *d = a - w[ip->b]; break;
-    case DM_T_MUL: *d = a * w[ip->b]; break;
-    case DM_T_DIV: *d = a / w[ip->b]; break;
-    case DM_T_NEG: *d = -a; break;
-    case DM_T_SQR: *d = a * a; break;
-    case DM_T_CUBE: *d = a * (a * a); break;
-    case DM_T_RECIP: *d = 1.0 / a; break;
-    case DM_T_POWI: *d = dm_tape_powi(a, (int32_t)ip->b); break;
-    case DM_T_POW: *d = pow(a, w[ip->b]); break;
-    case DM_T_ATAN2: *d = atan2(a, w[ip->b]); break;
-    case DM_T_SQRT: *d = sqrt(a); break;
-    case DM_T_EXP: *d = exp(a); break;
-    case DM_T_LOG: *d = log(a); break;
-    case DM_T_SIN: *d = sin(a); break;
-    case DM_T_COS: *d = cos(a); break;
-    case DM_T_TAN: *d = tan(a); break;
-    case DM_T_ASIN: *d = asin(a); break;
-    case DM_T_ACOS: *d = acos(a); break;
-    case DM_T_ATAN: *d = atan(a); break;
-    case DM_T_SINH: *d = sinh(a); break;
-    case DM_T_COSH: *d = cosh(a); break;
-    case DM_T_TANH: *d = tanh(a); break;
-    case DM_T_ABS: *d = fabs(a); break;
-    case DM_T_SIGN: *d = sign_of(a); break;
-    case DM_T_LT: *d = a < w[ip->b]; break;
-    case DM_T_LE: *d = a <= w[ip->b]; break;
-    case DM_T_GT: *d = a > w[ip->b]; break;
-    case DM_T_GE: *d = a >= w[ip->b]; break;
-    case DM_T_EQ: *d = a == w[ip->b]; break;
-    case DM_T_NE: *d = a != w[ip->b]; break;
-    case DM_T_SELECT: *d = w[ip->code >> 8] != 0 ? a : w[ip->b]; break;
-    default: break;
-    }
-  }
-  for (size_t k = 0; k < t->nout; k++)
-    out[k] = w[t->outreg[k]];
-}
-
-#define LOOP(expr) for (size_t j = 0; j < m; j++) d[j] = (expr); break
-
-/* One block of m <= BATCH points; registers are rows of BATCH doubles. */
-static void run_block(const dm_tape *t, double *W, size_t m)
-{
-  for (size_t i = 0; i < t->ninstr; i++) {
-    const dm_tape_ins *ip = &t->code[i];
-    double *d = W + (size_t)ip->d * BATCH;
-    const double *a = W + (size_t)ip->a * BATCH;
-    const double *b = W + (size_t)(ip->b % t->nregs) * BATCH;
-    switch (ip->code & 0xff) {
-    case DM_T_ADD: LOOP(a[j] + b[j]);
-    case DM_T_SUB: LOOP(a[j] - b[j]);
-    case DM_T_MUL: LOOP(a[j] * b[j]);
-    case DM_T_DIV: LOOP(a[j] / b[j]);
-    case DM_T_NEG: LOOP(-a[j]);
-    case DM_T_SQR: LOOP(a[j] * a[j]);
-    case DM_T_CUBE: LOOP(a[j] * (a[j] * a[j]));
-    case DM_T_RECIP: LOOP(1.0 / a[j]);
-    case DM_T_POWI: LOOP(dm_tape_powi(a[j], (int32_t)ip->b));
-    case DM_T_POW: LOOP(pow(a[j], b[j]));
-    case DM_T_ATAN2: LOOP(atan2(a[j], b[j]));
-    case DM_T_SQRT: LOOP(sqrt(a[j]));
-    case DM_T_EXP: LOOP(exp(a[j]));
-    case DM_T_LOG: LOOP(log(a[j]));
-    case DM_T_SIN: LOOP(sin(a[j]));
-    case DM_T_COS: LOOP(cos(a[j]));
-    case DM_T_TAN: LOOP(tan(a[j]));
-    case DM_T_ASIN: LOOP(asin(a[j]));
-    case DM_T_ACOS: LOOP(acos(a[j]));
-    case DM_T_ATAN: LOOP(atan(a[j]));
-    case DM_T_SINH: LOOP(sinh(a[j]));
-    case DM_T_COSH: LOOP(cosh(a[j]));
-    case DM_T_TANH: LOOP(tanh(a[j]));
-    case DM_T_ABS: LOOP(fabs(a[j]));
-    case DM_T_SIGN: LOOP(sign_of(a[j]));
-    case DM_T_LT: LOOP(a[j] < b[j]);
-    case DM_T_LE: LOOP(a[j] <= b[j]);
-    case DM_T_GT: LOOP(a[j] > b[j]);
-    case DM_T_GE: LOOP(a[j] >= b[j]);
-    case DM_T_EQ: LOOP(a[j] == b[j]);
-    case DM_T_NE: LOOP(a[j] != b[j]);
-    case DM_T_SELECT: {
-      const double *c = W + (size_t)(ip->code >> 8) * BATCH;
-      LOOP(c[j] != 0 ? a[j] : b[j]);
-    }
-    default: break;
-    }
-  }
-}
-
-void dm_tape_eval_batch(const dm_tape *t, size_t npts, const double *in,
-                        size_t in_stride, const double *par, double *out,
-                        size_t out_stride, double *W)
-{
-  /* parameters and constants are never overwritten: fill them once */
-  for (size_t k = 0; k < t->npar + t->nconst; k++) {
-    double v = k < t->npar ? par[k] : t->consts[k - t->npar];
-    double *r = W + (t->nin + k) * BATCH;
-    for (size_t j = 0; j < BATCH; j++)
-      r[j] = v;
-  }
-  for (size_t s = 0; s < npts; s += BATCH) {
-    size_t m = npts - s < BATCH ? npts - s : BATCH;
-    for (size_t j = 0; j < m; j++)
-      for (size_t i = 0; i < t->nin; i++)
-        W[i * BATCH + j] = in[(s + j) * in_stride + i];
-    run_block(t, W, m);
-    for (size_t j = 0; j < m; j++)
-      for (size_t k = 0; k < t->nout; k++)
-        out[(s + j) * out_stride + k] = W[(size_t)t->outreg[k] * BATCH + j];
-  }
-}

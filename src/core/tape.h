@@ -42,11 +42,18 @@ enum dm_tape_op {
   DM_T_ABS, DM_T_SIGN,
   DM_T_LT, DM_T_LE, DM_T_GT, DM_T_GE, DM_T_EQ, DM_T_NE,   /* 1.0 / 0.0 */
   DM_T_SELECT,  /* r[d] = r[c] != 0 ? r[a] : r[b], c = code >> 8 */
+  /* fused (a product used once, folded into its user; rounded as the two
+   * separate operations, never as an FMA): c = code >> 8 */
+  DM_T_MULADD,  /* r[a]*r[b] + r[c]          */
+  DM_T_MULSUB,  /* r[a]*r[b] - r[c]          */
+  DM_T_SUBMUL,  /* r[c] - r[a]*r[b]          */
+  DM_T_MUL3,    /* (r[a]*r[b])*r[c]          */
   DM_T_NOPS
 };
 
 /* One instruction: op = code & 0xff; d, a, b registers (b is the exponent
- * for POWI); SELECT keeps its condition register in code >> 8. */
+ * for POWI); SELECT and the fused ops keep a third register c in
+ * code >> 8. */
 typedef struct dm_tape_ins {
   uint32_t code;
   uint32_t d, a, b;
@@ -61,7 +68,9 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
 void dm_tape_free(dm_tape *t);
 
 /* out[nout] = outputs at (in[nin], par[npar]); work has dm_tape_work_size
- * doubles.  in / par may be NULL when nin / npar is 0. */
+ * doubles.  in / par may be NULL when nin / npar is 0.  in may be work
+ * itself (the inputs are its first nin registers: no copy).  out must not
+ * overlap work. */
 void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
                   double *out, double *work);
 size_t dm_tape_work_size(const dm_tape *t);

@@ -31,7 +31,7 @@ static double relerr(double got, double want)
 {
   if (got == want || (isnan(got) && isnan(want)))
     return 0;
-  return fabs(got - want) / fmax(1e-300, fabs(want));
+  return fabs(got - want) / fmax(1.0, fabs(want));
 }
 
 /* One tape for value + gradient + Hessian of every test expression. */
@@ -65,8 +65,8 @@ static void test_against_eval(void)
     for (size_t k = 0; k < nout; k++)
       worst = fmax(worst, relerr(y[k], ref[k]));
   }
-  tap_ok(worst == 0, "tape = DAG evaluation bit for bit at 20 random points "
-         "(max rel diff %.2g)", worst);
+  tap_ok(worst < 1e-13, "tape = DAG evaluation to round-off at 20 random "
+         "points (max rel diff %.2g; shared reciprocals round differently)", worst);
 
   /* batch over 77 points (not a multiple of the block) = single evals */
   enum { NP = 77 };
@@ -153,8 +153,9 @@ static void test_dsp_size(void)
            "(%zu sin, %zu cos, %zu sqrt, %zu div), %zu registers, %zu constants",
            dm_tape_ninstr(t), cnt[DM_T_SIN], cnt[DM_T_COS], cnt[DM_T_SQRT],
            cnt[DM_T_DIV], dm_tape_nregs(t), dm_tape_nconst(t));
-  tap_ok(cnt[DM_T_SIN] == 2 && cnt[DM_T_COS] == 2 && cnt[DM_T_SQRT] == 2,
-         "CSE: each sin, cos and sqrt computed once");
+  tap_ok(cnt[DM_T_SIN] == 2 && cnt[DM_T_COS] == 2 && cnt[DM_T_SQRT] == 2 &&
+         cnt[DM_T_DIV] == 0,
+         "CSE: each sin, cos and sqrt computed once; divisions share reciprocals");
   size_t separate = 0;
   for (int k = 0; k < 73; k++) {
     dm_tape *t1;
@@ -163,8 +164,8 @@ static void test_dsp_size(void)
     dm_tape_free(t1);
   }
   tap_diag("the 73 outputs compiled one by one: %zu instructions in all", separate);
-  tap_ok(dm_tape_ninstr(t) <= 420 && 4 * dm_tape_ninstr(t) < separate,
-         "CSE keeps the tape small (%zu <= 420 instructions, < 1/4 of the "
+  tap_ok(dm_tape_ninstr(t) <= 330 && 4 * dm_tape_ninstr(t) < separate,
+         "CSE keeps the tape small (%zu <= 330 instructions, < 1/4 of the "
          "outputs compiled separately)", dm_tape_ninstr(t));
   dm_tape_free(t);
 }
