@@ -18,6 +18,7 @@ typedef struct prog {
   dm_tape *tape;
   dm_native *nat;
   dm_native_fn fn;
+  dm_native_scatter_fn scatter;   /* native, writing the caller's arrays */
   size_t nout, nregs;
 } prog;
 
@@ -116,6 +117,11 @@ static int lag_eval(void *data, const double *q, const double *v,
   const lag_data *d = data;
   const size_t n = d->n;
   const prog *p = (what & ~(unsigned)DM_LAG_GRAD) ? &d->all : &d->grad;
+  if (p->scatter != NULL) {
+    const double *in[2] = { q, v };
+    double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
+    return p->scatter(in, par, o, what | DM_LAG_L);
+  }
   double *w = work;
   copy(w, q, n);
   copy(w + n, v, n);
@@ -149,6 +155,11 @@ static int force_eval(void *data, const double *q, const double *v,
   const lag_data *d = data;
   const size_t n = d->n;
   const prog *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  if (p->scatter != NULL) {
+    const double *in[2] = { q, v };
+    double *o[3] = { F, Fq, Fv };
+    return p->scatter(in, par, o, what);
+  }
   double *w = work;
   copy(w, q, n);
   copy(w + n, v, n);
@@ -171,6 +182,11 @@ static int constr_eval(void *data, const double *q, const double *par,
   const lag_data *d = data;
   const size_t n = d->n, m = d->m;
   const prog *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
+  if (p->scatter != NULL) {
+    const double *in[1] = { q };
+    double *o[3] = { g, G, H };
+    return p->scatter(in, par, o, what);
+  }
   double *w = work;
   copy(w, q, n);
   const double *o = prog_run(p, w, par);
@@ -207,8 +223,53 @@ static int ctx_fail(builder *b, const char *what)
                     what, e->msg[0] ? e->msg : "cannot build the derivatives");
 }
 
+/* Where the outputs of a bundle go: blocks of one array each, in output
+ * order -- vectors, full matrices, symmetric matrices (packed upper
+ * triangles, written to both halves), `rep` times at a stride. */
+enum { BLK_VEC, BLK_FULL, BLK_SYM };
+typedef struct block {
+  unsigned arr, kind;
+  size_t len;               /* vector length or matrix order */
+  size_t rep, stride;       /* repetitions (constraint Hessians) */
+} block;
+
+/* Output map for the blocks, cut at nout outputs; *nmap entries. */
+static dm_native_map *make_outmap(const block *blk, size_t nblk, size_t nout,
+                                  size_t *nmap)
+{
+  size_t cap = 2 * nout + 1, j = 0, k = 0;
+  dm_native_map *m = malloc(cap * sizeof *m);
+  if (m == NULL)
+    return NULL;
+  for (size_t bi = 0; bi < nblk && k < nout; bi++) {
+    const block *B = &blk[bi];
+    size_t n = B->len;
+    for (size_t r = 0; r < B->rep && k < nout; r++) {
+      uint32_t off = (uint32_t)(r * B->stride);
+      if (B->kind == BLK_VEC) {
+        for (size_t i = 0; i < n && k < nout; i++, k++)
+          m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)i };
+      } else if (B->kind == BLK_FULL) {
+        for (size_t i = 0; i < n * n && k < nout; i++, k++)
+          m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)i };
+      } else {
+        for (size_t i = 0; i < n; i++)
+          for (size_t c = i; c < n && k < nout; c++, k++) {
+            m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)(i * n + c) };
+            if (c != i)
+              m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)(c * n + i) };
+          }
+      }
+    }
+  }
+  *nmap = j;
+  return m;
+}
+
+/* Compile a bundle: the tape, and native code (with its scattering
+ * function for the blocks) when the mode asks for it. */
 static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
-                        size_t nin)
+                        size_t nin, const block *blk, size_t nblk)
 {
   const dm_lagrangian_spec *sp = b->sp;
   int s = dm_tape_compile(b->ctx, nout, out, nin, b->in, sp->npar, sp->par,
@@ -219,11 +280,25 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
   p->nregs = dm_tape_work_size(p->tape);
   if (sp->native == DM_NATIVE_NEVER)
     return DM_OK;
+  size_t nmap = 0, n = sp->n;
+  dm_native_map *inmap = malloc((nin + 1) * sizeof *inmap);
+  dm_native_map *outmap = make_outmap(blk, nblk, nout, &nmap);
+  if (inmap == NULL || outmap == NULL) {
+    free(inmap);
+    free(outmap);
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  }
+  for (size_t i = 0; i < nin; i++)           /* q, then v */
+    inmap[i] = (dm_native_map){ (uint32_t)i, (uint32_t)(i / n), (uint32_t)(i % n) };
   dm_err nerr;
-  s = dm_native_compile(p->tape, b->in0, sp->par_values, &p->nat, &nerr);
-  if (s == DM_OK)
+  s = dm_native_compile_mapped(p->tape, b->in0, sp->par_values, inmap, nmap,
+                               outmap, &p->nat, &nerr);
+  free(inmap);
+  free(outmap);
+  if (s == DM_OK) {
     p->fn = dm_native_function(p->nat);
-  else if (sp->native == DM_NATIVE_ALWAYS || s == DM_EINTR) {
+    p->scatter = dm_native_scatter(p->nat);
+  } else if (sp->native == DM_NATIVE_ALWAYS || s == DM_EINTR) {
     if (b->err != NULL)
       *b->err = nerr;
     return s;
@@ -347,7 +422,7 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
   dm_lagrangian_spec tsp = *sp;
   tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
   nb.sp = &tsp;
-  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n);
+  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0);
   if (s != DM_OK)
     return s;
   d->mass_possible = 1;
@@ -395,8 +470,11 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     for (size_t j = i; j < n; j++)
       *o++ = H[i * m + j];
   free(H);
-  if ((s = compile_prog(b, &d->grad, 1 + 2 * n, out, 2 * n)) != DM_OK ||
-      (s = compile_prog(b, &d->all, nall, out, 2 * n)) != DM_OK)
+  const block blk[] = { { 0, BLK_VEC, 1, 1, 0 }, { 1, BLK_VEC, n, 1, 0 },
+                        { 2, BLK_VEC, n, 1, 0 }, { 3, BLK_SYM, n, 1, 0 },
+                        { 4, BLK_FULL, n, 1, 0 }, { 5, BLK_SYM, n, 1, 0 } };
+  if ((s = compile_prog(b, &d->grad, 1 + 2 * n, out, 2 * n, blk, 6)) != DM_OK ||
+      (s = compile_prog(b, &d->all, nall, out, 2 * n, blk, 6)) != DM_OK)
     goto done;
   s = detect_structure(b, d, Lv, Lvv, Lvq, flags);
 done:
@@ -414,14 +492,16 @@ static int build_force(builder *b, lag_data *d)
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->force, n * sizeof *out);
+  const block blk[] = { { 0, BLK_VEC, n, 1, 0 }, { 1, BLK_FULL, n, 1, 0 },
+                        { 2, BLK_FULL, n, 1, 0 } };
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, n, sp->force, n, sp->q, out + n, NULL) != DM_OK ||
       dm_expr_jacobian(b->ctx, n, sp->force, n, sp->v, out + n + n * n, NULL) != DM_OK)
     s = ctx_fail(b, "force");
   if (s == DM_OK)
-    s = compile_prog(b, &d->force, n, out, 2 * n);
+    s = compile_prog(b, &d->force, n, out, 2 * n, blk, 3);
   if (s == DM_OK)
-    s = compile_prog(b, &d->force_all, nall, out, 2 * n);
+    s = compile_prog(b, &d->force_all, nall, out, 2 * n, blk, 3);
   free(out);
   return s;
 }
@@ -435,6 +515,8 @@ static int build_constraints(builder *b, lag_data *d)
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->constraints, m * sizeof *out);
+  const block blk[] = { { 0, BLK_VEC, m, 1, 0 }, { 1, BLK_VEC, m * n, 1, 0 },
+                        { 2, BLK_SYM, n, m, n * n } };
   dm_expr *G = out + m, *o = out + m + m * n;
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)
@@ -446,9 +528,9 @@ static int build_constraints(builder *b, lag_data *d)
   if (s == DM_OK && dm_expr_ctx_err(b->ctx)->status != DM_OK)
     s = ctx_fail(b, "constraints");
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr, m + m * n, out, n);
+    s = compile_prog(b, &d->constr, m + m * n, out, n, blk, 3);
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr_all, nall, out, n);
+    s = compile_prog(b, &d->constr_all, nall, out, n, blk, 3);
   free(out);
   return s;
 }

@@ -1,35 +1,27 @@
 /* native.c -- emit C for a tape, compile it with the system compiler, load
  * it, check it against the tape, cache the object.  See native.h. */
 #include <config.h>
-#include "native.h"
-#include "interrupt.h"
+#include "native_impl.h"
 
 #include <dlfcn.h>
 #include <errno.h>
-#include <fcntl.h>
+#include <float.h>
 #include <math.h>
-#include <poll.h>
-#include <spawn.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <sys/types.h>
-#include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
-extern char **environ;
-
-#define CC_FLAGS "-O2 -fPIC -shared -ffp-contract=off"
-#define CC_TIMEOUT 300.0      /* seconds */
 #define ID_SYMBOL "dm_native_id"
 
 struct dm_native {
   void *dl;
   dm_native_fn fn;
+  dm_native_scatter_fn scatter;         /* NULL unless compiled mapped */
+  const dm_native_map *inmap, *outmap;  /* during compilation only */
+  size_t nmap;
   int cached;
   char key[65];
 };
@@ -44,6 +36,7 @@ void dm_native_free(dm_native *nat)
 }
 
 dm_native_fn dm_native_function(const dm_native *nat) { return nat->fn; }
+dm_native_scatter_fn dm_native_scatter(const dm_native *nat) { return nat->scatter; }
 int dm_native_cached(const dm_native *nat) { return nat->cached; }
 const char *dm_native_key(const dm_native *nat) { return nat->key; }
 
@@ -63,99 +56,6 @@ int dm_native_mode_parse(const char *name)
     if (name != NULL && strcmp(name, dm_native_mode_name(m)) == 0)
       return m;
   return -1;
-}
-
-/* {==================================================================
- * SHA-256 (FIPS 180-4), for cache keys
- * =================================================================== */
-
-typedef struct sha256 {
-  uint32_t h[8];
-  uint64_t len;
-  unsigned char buf[64];
-  size_t nbuf;
-} sha256;
-
-static const uint32_t K256[64] = {
-  0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1,
-  0x923f82a4, 0xab1c5ed5, 0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3,
-  0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174, 0xe49b69c1, 0xefbe4786,
-  0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
-  0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147,
-  0x06ca6351, 0x14292967, 0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13,
-  0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85, 0xa2bfe8a1, 0xa81a664b,
-  0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
-  0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a,
-  0x5b9cca4f, 0x682e6ff3, 0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208,
-  0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2
-};
-
-#define ROR(x, n) (((x) >> (n)) | ((x) << (32 - (n))))
-
-static void sha_block(sha256 *s, const unsigned char *p)
-{
-  uint32_t w[64], v[8];
-  for (int i = 0; i < 16; i++)
-    w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 |
-           (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
-  for (int i = 16; i < 64; i++) {
-    uint32_t s0 = ROR(w[i - 15], 7) ^ ROR(w[i - 15], 18) ^ (w[i - 15] >> 3);
-    uint32_t s1 = ROR(w[i - 2], 17) ^ ROR(w[i - 2], 19) ^ (w[i - 2] >> 10);
-    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-  }
-  memcpy(v, s->h, sizeof v);
-  for (int i = 0; i < 64; i++) {
-    uint32_t S1 = ROR(v[4], 6) ^ ROR(v[4], 11) ^ ROR(v[4], 25);
-    uint32_t ch = (v[4] & v[5]) ^ (~v[4] & v[6]);
-    uint32_t t1 = v[7] + S1 + ch + K256[i] + w[i];
-    uint32_t S0 = ROR(v[0], 2) ^ ROR(v[0], 13) ^ ROR(v[0], 22);
-    uint32_t mj = (v[0] & v[1]) ^ (v[0] & v[2]) ^ (v[1] & v[2]);
-    memmove(v + 1, v, 7 * sizeof *v);
-    v[4] += t1;
-    v[0] = t1 + S0 + mj;
-  }
-  for (int i = 0; i < 8; i++)
-    s->h[i] += v[i];
-}
-
-static void sha_init(sha256 *s)
-{
-  static const uint32_t h0[8] = { 0x6a09e667, 0xbb67ae85, 0x3c6ef372,
-    0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19 };
-  memcpy(s->h, h0, sizeof h0);
-  s->len = 0;
-  s->nbuf = 0;
-}
-
-static void sha_update(sha256 *s, const void *data, size_t n)
-{
-  const unsigned char *p = data;
-  s->len += n;
-  while (n > 0) {
-    size_t k = 64 - s->nbuf < n ? 64 - s->nbuf : n;
-    memcpy(s->buf + s->nbuf, p, k);
-    s->nbuf += k;
-    p += k;
-    n -= k;
-    if (s->nbuf == 64) {
-      sha_block(s, s->buf);
-      s->nbuf = 0;
-    }
-  }
-}
-
-static void sha_hex(sha256 *s, char hex[65])
-{
-  uint64_t bits = s->len * 8;
-  unsigned char pad = 0x80, zero = 0, lenb[8];
-  sha_update(s, &pad, 1);
-  while (s->nbuf != 56)
-    sha_update(s, &zero, 1);
-  for (int i = 0; i < 8; i++)
-    lenb[i] = (unsigned char)(bits >> (56 - 8 * i));
-  sha_update(s, lenb, 8);
-  for (int i = 0; i < 8; i++)
-    snprintf(hex + 8 * i, 9, "%08x", (unsigned)s->h[i]);
 }
 
 /* {==================================================================
@@ -201,12 +101,12 @@ static void sb_printf(sbuf *b, const char *fmt, ...)
 /* The C expression for register r; writer[r] = instruction that last
  * wrote the temporary r. */
 static void operand(char *buf, size_t size, const dm_tape *t, uint32_t r,
-                    const size_t *writer)
+                    const size_t *writer, int mapped)
 {
   size_t nin = dm_tape_nin(t), npar = dm_tape_npar(t);
   size_t base = nin + npar + dm_tape_nconst(t);
   if (r < nin)
-    snprintf(buf, size, "in[%u]", r);
+    snprintf(buf, size, mapped ? "x%u" : "in[%u]", r);
   else if (r < nin + npar)
     snprintf(buf, size, "par[%zu]", r - nin);
   else if (r < base) {
@@ -239,7 +139,7 @@ static const char *const c_infix[DM_T_NOPS] = {
 
 static const char prelude[] =
   "/* generated by dmech from a tape: do not edit */\n"
-  "#include <math.h>\n#include <stddef.h>\n"
+  "#include <float.h>\n#include <math.h>\n#include <stddef.h>\n"
   "static inline double dm_powi(double x, int n)\n{\n"
   "  unsigned long u = n < 0 ? (unsigned long)(-(long)n) : (unsigned long)n;\n"
   "  double r = 1.0, p = x;\n"
@@ -248,65 +148,110 @@ static const char prelude[] =
   "static inline double dm_sign(double x)\n"
   "{\n  return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;\n}\n";
 
-char *dm_native_source(const dm_tape *t)
+/* The straight-line body: one local per instruction. */
+static void emit_body(sbuf *b, const dm_tape *t, size_t *writer, int mapped)
 {
-  sbuf b = { NULL, 0, 0, 0 };
-  size_t n = dm_tape_ninstr(t), nregs = dm_tape_nregs(t);
-  size_t *writer = calloc(nregs ? nregs : 1, sizeof *writer);
-  if (writer == NULL)
-    return NULL;
-  sb_printf(&b, "%s\nvoid dm_native_eval(const double *restrict in, "
-            "const double *restrict par, double *restrict out)\n{\n"
-            "  (void)in; (void)par;\n", prelude);
   const dm_tape_ins *code = dm_tape_code(t);
   char x[64], y[64], c[64];
-  for (size_t i = 0; i < n && !b.nomem; i++) {
+  for (size_t i = 0; i < dm_tape_ninstr(t) && !b->nomem; i++) {
     const dm_tape_ins *ip = &code[i];
     int op = (int)(ip->code & 0xff);
-    operand(x, sizeof x, t, ip->a, writer);
     int fused = op >= DM_T_MULADD && op <= DM_T_MUL3;
-    if (op != DM_T_POWI && op != DM_T_SELECT && c_infix[op] == NULL &&
-        op != DM_T_POW && op != DM_T_ATAN2 && !fused)
-      y[0] = '\0';
-    else if (op != DM_T_POWI)
-      operand(y, sizeof y, t, ip->b, writer);
-    if (fused)
-      operand(c, sizeof c, t, ip->code >> 8, writer);
-    sb_printf(&b, "  const double t%zu = ", i);
+    operand(x, sizeof x, t, ip->a, writer, mapped);
+    y[0] = c[0] = '\0';
+    if (op == DM_T_SELECT || c_infix[op] != NULL || op == DM_T_POW ||
+        op == DM_T_ATAN2 || fused)
+      operand(y, sizeof y, t, ip->b, writer, mapped);
+    if (op == DM_T_SELECT || fused)
+      operand(c, sizeof c, t, ip->code >> 8, writer, mapped);
+    sb_printf(b, "  const double t%zu = ", i);
     switch (op) {
-    case DM_T_NEG: sb_printf(&b, "-%s;\n", x); break;
-    case DM_T_SQR: sb_printf(&b, "%s * %s;\n", x, x); break;
-    case DM_T_CUBE: sb_printf(&b, "%s * (%s * %s);\n", x, x, x); break;
-    case DM_T_RECIP: sb_printf(&b, "1.0 / %s;\n", x); break;
-    case DM_T_POWI: sb_printf(&b, "dm_powi(%s, %d);\n", x, (int32_t)ip->b); break;
+    case DM_T_NEG: sb_printf(b, "-%s;\n", x); break;
+    case DM_T_SQR: sb_printf(b, "%s * %s;\n", x, x); break;
+    case DM_T_CUBE: sb_printf(b, "%s * (%s * %s);\n", x, x, x); break;
+    case DM_T_RECIP: sb_printf(b, "1.0 / %s;\n", x); break;
+    case DM_T_POWI: sb_printf(b, "dm_powi(%s, %d);\n", x, (int32_t)ip->b); break;
     case DM_T_POW: case DM_T_ATAN2:
-      sb_printf(&b, "%s(%s, %s);\n", c_func[op], x, y);
+      sb_printf(b, "%s(%s, %s);\n", c_func[op], x, y);
       break;
-    case DM_T_SELECT:
-      operand(c, sizeof c, t, ip->code >> 8, writer);
-      sb_printf(&b, "%s != 0 ? %s : %s;\n", c, x, y);
-      break;
-    case DM_T_MULADD: sb_printf(&b, "%s * %s + %s;\n", x, y, c); break;
-    case DM_T_MULSUB: sb_printf(&b, "%s * %s - %s;\n", x, y, c); break;
-    case DM_T_SUBMUL: sb_printf(&b, "%s - %s * %s;\n", c, x, y); break;
-    case DM_T_MUL3: sb_printf(&b, "%s * %s * %s;\n", x, y, c); break;
+    case DM_T_SELECT: sb_printf(b, "%s != 0 ? %s : %s;\n", c, x, y); break;
+    case DM_T_MULADD: sb_printf(b, "%s * %s + %s;\n", x, y, c); break;
+    case DM_T_MULSUB: sb_printf(b, "%s * %s - %s;\n", x, y, c); break;
+    case DM_T_SUBMUL: sb_printf(b, "%s - %s * %s;\n", c, x, y); break;
+    case DM_T_MUL3: sb_printf(b, "%s * %s * %s;\n", x, y, c); break;
     default:
       if (c_infix[op] != NULL && op >= DM_T_LT)
-        sb_printf(&b, "(%s %s %s) ? 1.0 : 0.0;\n", x, c_infix[op], y);
+        sb_printf(b, "(%s %s %s) ? 1.0 : 0.0;\n", x, c_infix[op], y);
       else if (c_infix[op] != NULL)
-        sb_printf(&b, "%s %s %s;\n", x, c_infix[op], y);
+        sb_printf(b, "%s %s %s;\n", x, c_infix[op], y);
       else
-        sb_printf(&b, "%s(%s);\n", c_func[op], x);
+        sb_printf(b, "%s(%s);\n", c_func[op], x);
       break;
     }
     writer[ip->d] = i;
   }
+}
+
+/* dm_native_scatter: inputs gathered through inmap, every output checked
+ * for NaN/Inf, then written to its destinations array by array (mask). */
+static void emit_scatter(sbuf *b, const dm_tape *t, size_t *writer,
+                         const dm_native_map *inmap, size_t nmap,
+                         const dm_native_map *outmap)
+{
+  char x[64];
+  sb_printf(b, "\nint dm_native_scatter(const double *const *restrict in, "
+            "const double *restrict par, double *const *restrict out, "
+            "unsigned mask)\n{\n  (void)in; (void)par;\n");
+  for (size_t i = 0; i < dm_tape_nin(t); i++)
+    sb_printf(b, "  const double x%zu = in[%u][%u];\n", i, inmap[i].arr,
+              inmap[i].elem);
+  emit_body(b, t, writer, 1);
+  const uint32_t *outreg = dm_tape_outregs(t);
+  sb_printf(b, "  int bad = 0;\n");
+  for (size_t k = 0; k < dm_tape_nout(t); k++) {
+    operand(x, sizeof x, t, outreg[k], writer, 1);
+    if (x[0] == 't' || x[0] == 'x' || x[0] == 'p')
+      sb_printf(b, "  bad |= !(fabs(%s) <= DBL_MAX);\n", x);
+  }
+  sb_printf(b, "  if (bad)\n    return 1;\n");
+  uint32_t maxarr = 0;
+  for (size_t j = 0; j < nmap; j++)
+    if (outmap[j].arr > maxarr)
+      maxarr = outmap[j].arr;
+  for (uint32_t a = 0; a <= maxarr; a++) {
+    sb_printf(b, "  if (mask & %uu) {\n", 1u << a);
+    for (size_t j = 0; j < nmap; j++)
+      if (outmap[j].arr == a) {
+        operand(x, sizeof x, t, outreg[outmap[j].k], writer, 1);
+        sb_printf(b, "    out[%u][%u] = %s;\n", a, outmap[j].elem, x);
+      }
+    sb_printf(b, "  }\n");
+  }
+  sb_printf(b, "  return 0;\n}\n");
+}
+
+/* The whole source: the flat function, and the scatter one when mapped. */
+static char *emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
+                  const dm_native_map *outmap)
+{
+  sbuf b = { NULL, 0, 0, 0 };
+  size_t nregs = dm_tape_nregs(t);
+  size_t *writer = calloc(nregs ? nregs : 1, sizeof *writer);
+  if (writer == NULL)
+    return NULL;
+  char x[64];
+  sb_printf(&b, "%s\nvoid dm_native_eval(const double *restrict in, "
+            "const double *restrict par, double *restrict out)\n{\n"
+            "  (void)in; (void)par;\n", prelude);
+  emit_body(&b, t, writer, 0);
   const uint32_t *outreg = dm_tape_outregs(t);
   for (size_t k = 0; k < dm_tape_nout(t); k++) {
-    operand(x, sizeof x, t, outreg[k], writer);
+    operand(x, sizeof x, t, outreg[k], writer, 0);
     sb_printf(&b, "  out[%zu] = %s;\n", k, x);
   }
   sb_printf(&b, "}\n");
+  if (inmap != NULL)
+    emit_scatter(&b, t, writer, inmap, nmap, outmap);
   free(writer);
   if (b.nomem) {
     free(b.s);
@@ -315,225 +260,9 @@ char *dm_native_source(const dm_tape *t)
   return b.s;
 }
 
-/* {==================================================================
- * running the compiler
- * =================================================================== */
-
-static double now(void)
+char *dm_native_source(const dm_tape *t)
 {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* Split $CC (else "cc") at blanks into argv[0..k), return k (0: none). */
-static int cc_words(char *copy, char **argv, int max)
-{
-  int k = 0;
-  char *save = NULL;
-  for (char *p = strtok_r(copy, " \t", &save); p != NULL && k < max;
-       p = strtok_r(NULL, " \t", &save))
-    argv[k++] = p;
-  return k;
-}
-
-/* Run argv with stdin from /dev/null and stdout + stderr captured into out
- * (at most size-1 bytes kept, NUL-terminated).  *status is the exit code
- * (128 + signal when killed).  Returns a dm status. */
-static int run(char *const argv[], char *out, size_t size, int *status,
-               dm_err *err)
-{
-  int fd[2];
-  if (pipe(fd) != 0)
-    return dm_err_set(err, DM_EIO, "native: pipe: %s", strerror(errno));
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_adddup2(&fa, fd[1], 1);
-  posix_spawn_file_actions_adddup2(&fa, fd[1], 2);
-  posix_spawn_file_actions_addclose(&fa, fd[0]);
-  posix_spawn_file_actions_addclose(&fa, fd[1]);
-  pid_t pid;
-  int rc = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
-  posix_spawn_file_actions_destroy(&fa);
-  close(fd[1]);
-  if (rc != 0) {
-    close(fd[0]);
-    return dm_err_set(err, rc == ENOENT ? DM_ENOTFOUND : DM_EIO,
-                      "native: cannot run C compiler '%s': %s", argv[0],
-                      strerror(rc));
-  }
-  size_t len = 0;
-  int result = DM_OK;
-  double t0 = now();
-  for (;;) {
-    struct pollfd p = { fd[0], POLLIN, 0 };
-    int k = poll(&p, 1, 50);
-    if (k > 0) {
-      char tmp[4096];
-      ssize_t r = read(fd[0], tmp, sizeof tmp);
-      if (r == 0)
-        break;
-      if (r > 0 && len + 1 < size) {
-        size_t m = (size_t)r < size - 1 - len ? (size_t)r : size - 1 - len;
-        memcpy(out + len, tmp, m);
-        len += m;
-      }
-      if (r < 0 && errno != EINTR)
-        break;
-    }
-    if (dm_interrupted() || now() - t0 > CC_TIMEOUT) {
-      result = dm_interrupted() ? DM_EINTR : DM_ETIMEOUT;
-      kill(pid, SIGKILL);
-      break;
-    }
-  }
-  out[len] = '\0';
-  close(fd[0]);
-  int ws;
-  while (waitpid(pid, &ws, 0) < 0 && errno == EINTR)
-    ;
-  *status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
-  if (result == DM_EINTR)
-    return dm_err_set(err, DM_EINTR, "native: compilation interrupted");
-  if (result == DM_ETIMEOUT)
-    return dm_err_set(err, DM_ETIMEOUT, "native: %s ran longer than %.0f s",
-                      argv[0], CC_TIMEOUT);
-  /* glibc reports a failed exec as exit status 127 */
-  if (*status == 127 && len == 0)
-    return dm_err_set(err, DM_ENOTFOUND, "native: cannot run C compiler '%s'",
-                      argv[0]);
-  return DM_OK;
-}
-
-/* {==================================================================
- * files and the cache
- * =================================================================== */
-
-static int write_file(const char *path, const void *data, size_t n)
-{
-  int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0)
-    return -1;
-  const char *p = data;
-  while (n > 0) {
-    ssize_t w = write(fd, p, n);
-    if (w < 0 && errno == EINTR)
-      continue;
-    if (w <= 0) {
-      close(fd);
-      return -1;
-    }
-    p += w;
-    n -= (size_t)w;
-  }
-  return close(fd);
-}
-
-/* Whole file into a malloc'ed buffer, or NULL. */
-static char *read_file(const char *path, size_t *n)
-{
-  FILE *f = fopen(path, "rb");
-  if (f == NULL)
-    return NULL;
-  char *buf = NULL;
-  size_t len = 0, cap = 0;
-  for (;;) {
-    if (len == cap) {
-      cap = cap ? 2 * cap : 65536;
-      char *p = realloc(buf, cap);
-      if (p == NULL)
-        break;
-      buf = p;
-    }
-    size_t r = fread(buf + len, 1, cap - len, f);
-    len += r;
-    if (r == 0)
-      break;
-  }
-  int bad = ferror(f);
-  fclose(f);
-  if (bad || buf == NULL) {
-    free(buf);
-    return NULL;
-  }
-  *n = len;
-  return buf;
-}
-
-/* A directory we own, not accessible to others (created 0700 if missing). */
-static int private_dir(const char *path)
-{
-  struct stat st;
-  if (mkdir(path, 0700) != 0 && errno != EEXIST)
-    return -1;
-  if (lstat(path, &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid()
-      || (st.st_mode & 077) != 0)
-    return -1;
-  return 0;
-}
-
-/* $XDG_CACHE_HOME/dmech or $HOME/.cache/dmech into dir; -1 when there is
- * no usable cache directory. */
-static int cache_dir(char *dir, size_t size)
-{
-  const char *x = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
-  char base[4096];
-  if (x != NULL && x[0] == '/')
-    snprintf(base, sizeof base, "%s", x);
-  else if (home != NULL && home[0] == '/')
-    snprintf(base, sizeof base, "%s/.cache", home);
-  else
-    return -1;
-  /* the base may be missing: create it (and only it) privately */
-  if (mkdir(base, 0700) != 0 && errno != EEXIST)
-    return -1;
-  if ((size_t)snprintf(dir, size, "%s/dmech", base) >= size)
-    return -1;
-  return private_dir(dir);
-}
-
-/* A cached object is used only if it is a regular file of ours that
- * nobody else can write. */
-static int trusted_file(const char *path)
-{
-  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0)
-    return 0;
-  struct stat st;
-  int ok = fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
-           st.st_uid == getuid() && (st.st_mode & 022) == 0;
-  close(fd);
-  return ok;
-}
-
-/* Copy the object into the cache: temporary name, 0600, rename. */
-static int cache_store(const char *dir, const char *final, const char *obj)
-{
-  size_t n;
-  char *data = read_file(obj, &n), tmp[4200];
-  if (data == NULL)
-    return -1;
-  snprintf(tmp, sizeof tmp, "%s/.tmp-XXXXXX", dir);
-  int fd = mkstemp(tmp);
-  int bad = fd < 0;
-  for (size_t off = 0; !bad && off < n;) {
-    ssize_t w = write(fd, data + off, n - off);
-    if (w < 0 && errno == EINTR)
-      continue;
-    bad = w <= 0;
-    off += bad ? 0 : (size_t)w;
-  }
-  free(data);
-  if (fd >= 0) {
-    bad |= fchmod(fd, 0600) != 0;
-    bad |= close(fd) != 0;
-    if (bad || rename(tmp, final) != 0) {
-      unlink(tmp);
-      return -1;
-    }
-  }
-  return bad ? -1 : 0;
+  return emit(t, NULL, 0, NULL);
 }
 
 /* {==================================================================
@@ -553,9 +282,53 @@ static int agree(double a, double b)
   return fabs(a - b) <= 1e-15 * fmax(fabs(a), fabs(b));
 }
 
+/* The scatter function against the flat one at (in, par) with outputs o:
+ * same return code, and every destination holds its output exactly. */
+static int check_scatter(const dm_tape *t, const dm_native *nat,
+                         const double *in, const double *par, const double *o)
+{
+  size_t nin = dm_tape_nin(t), nout = dm_tape_nout(t), nmap = nat->nmap;
+  enum { MAXARR = 32 };
+  size_t isz[MAXARR] = { 0 }, osz[MAXARR] = { 0 }, total = 0;
+  for (size_t i = 0; i < nin; i++)
+    if (nat->inmap[i].elem + 1 > isz[nat->inmap[i].arr])
+      isz[nat->inmap[i].arr] = nat->inmap[i].elem + 1;
+  for (size_t j = 0; j < nmap; j++)
+    if (nat->outmap[j].elem + 1 > osz[nat->outmap[j].arr])
+      osz[nat->outmap[j].arr] = nat->outmap[j].elem + 1;
+  for (int a = 0; a < MAXARR; a++)
+    total += isz[a] + osz[a];
+  double *buf = malloc((total + 1) * sizeof *buf), *p = buf;
+  const double *ins[MAXARR];
+  double *outs[MAXARR];
+  if (buf == NULL)
+    return -1;
+  for (int a = 0; a < MAXARR; a++) {
+    ins[a] = p;
+    p += isz[a];
+    outs[a] = p;
+    for (size_t e = 0; e < osz[a]; e++)
+      p[e] = -12345.678;                    /* unwritten marker */
+    p += osz[a];
+  }
+  for (size_t i = 0; i < nin; i++)
+    ((double *)ins[nat->inmap[i].arr])[nat->inmap[i].elem] = in[i];
+  int bad = 0;
+  for (size_t k = 0; k < nout; k++)
+    bad |= !(fabs(o[k]) <= DBL_MAX);
+  int r = nat->scatter(ins, par, outs, ~0u), ok = (r != 0) == bad;
+  for (size_t j = 0; ok && !bad && j < nmap; j++) {
+    double got = outs[nat->outmap[j].arr][nat->outmap[j].elem];
+    ok = got == o[nat->outmap[j].k] || (isnan(got) && isnan(o[nat->outmap[j].k]));
+  }
+  free(buf);
+  return ok ? 0 : -1;
+}
+
 /* The native function against the tape at 16 points: near (in0, par0)
- * when given, and uniformly random in [-2, 2]. */
-static int verify(const dm_tape *t, dm_native_fn fn, const double *in0,
+ * when given, and uniformly random in [-2, 2]; the scatter function, when
+ * there is one, against the flat one. */
+static int verify(const dm_tape *t, const dm_native *nat, const double *in0,
                   const double *par0, dm_err *err)
 {
   size_t nin = dm_tape_nin(t), npar = dm_tape_npar(t), nout = dm_tape_nout(t);
@@ -577,7 +350,7 @@ static int verify(const dm_tape *t, dm_native_fn fn, const double *in0,
       par[i] = par0 ? par0[i] * (rep < 2 ? 1 : 1 + 0.05 * (urand(&seed) - 0.5))
                     : 4 * urand(&seed) - 2;
     dm_tape_eval(t, in, par, o1, w);
-    fn(in, par, o2);
+    nat->fn(in, par, o2);
     for (size_t k = 0; k < nout; k++)
       if (!agree(o1[k], o2[k])) {
         status = dm_err_set(err, DM_EFAILED, "native: compiled code gives "
@@ -585,6 +358,9 @@ static int verify(const dm_tape *t, dm_native_fn fn, const double *in0,
                             o2[k], k + 1, o1[k]);
         break;
       }
+    if (status == DM_OK && nat->scatter && check_scatter(t, nat, in, par, o2) != 0)
+      status = dm_err_set(err, DM_EFAILED, "native: the scattering function "
+                          "disagrees with the flat one");
   }
   free(buf);
   return status;
@@ -602,75 +378,15 @@ static int load(const char *path, const char *key, dm_native *nat, dm_err *err)
     dlclose(dl);
     return dm_err_set(err, DM_EIO, "native: %s is not the expected object", path);
   }
+  void *sc = nat->inmap ? dlsym(dl, "dm_native_scatter") : NULL;
+  if (nat->inmap && sc == NULL) {
+    dlclose(dl);
+    return dm_err_set(err, DM_EIO, "native: %s lacks dm_native_scatter", path);
+  }
   nat->dl = dl;
   memcpy(&nat->fn, &fn, sizeof fn);     /* object to function pointer */
-  return DM_OK;
-}
-
-/* Compile src into dir/f.so (files in dir, which the caller removes). */
-static int build(char **ccargv, int ncc, const char *dir, const char *src,
-                 char *obj, size_t objsize, dm_err *err)
-{
-  char cpath[4200], flags[] = CC_FLAGS, *argv[64], msg[2048];
-  int k = 0, status;
-  snprintf(cpath, sizeof cpath, "%s/f.c", dir);
-  snprintf(obj, objsize, "%s/f.so", dir);
-  if (write_file(cpath, src, strlen(src)) != 0)
-    return dm_err_set(err, DM_EIO, "native: cannot write %s: %s", cpath,
-                      strerror(errno));
-  for (int i = 0; i < ncc; i++)
-    argv[k++] = ccargv[i];
-  k += cc_words(flags, argv + k, 16);
-  argv[k++] = "-o";
-  argv[k++] = obj;
-  argv[k++] = cpath;
-  argv[k++] = "-lm";
-  argv[k] = NULL;
-  int s = run(argv, msg, sizeof msg, &status, err);
-  if (s != DM_OK)
-    return s;
-  if (status != 0)
-    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s",
-                      ccargv[0], status, msg);
-  return DM_OK;
-}
-
-static void remove_tree(const char *dir)
-{
-  char p[4200];
-  static const char *const files[] = { "f.c", "f.so" };
-  for (size_t i = 0; i < 2; i++) {
-    snprintf(p, sizeof p, "%s/%s", dir, files[i]);
-    unlink(p);
-  }
-  rmdir(dir);
-}
-
-/* The key: SHA-256 of the source, the compiler command, its --version
- * output and the flags. */
-static int make_key(char **ccargv, int ncc, const char *src, char key[65],
-                    dm_err *err)
-{
-  char *argv[40], ver[4096];
-  int status;
-  for (int i = 0; i < ncc; i++)
-    argv[i] = ccargv[i];
-  argv[ncc] = "--version";
-  argv[ncc + 1] = NULL;
-  int s = run(argv, ver, sizeof ver, &status, err);
-  if (s != DM_OK)
-    return s;
-  if (status != 0)
-    return dm_err_set(err, DM_ENOTFOUND, "native: '%s --version' failed "
-                      "(exit %d)", ccargv[0], status);
-  sha256 h;
-  sha_init(&h);
-  for (int i = 0; i < ncc; i++)
-    sha_update(&h, ccargv[i], strlen(ccargv[i]) + 1);
-  sha_update(&h, ver, strlen(ver) + 1);
-  sha_update(&h, CC_FLAGS, sizeof CC_FLAGS);
-  sha_update(&h, src, strlen(src));
-  sha_hex(&h, key);
+  if (sc != NULL)
+    memcpy(&nat->scatter, &sc, sizeof sc);
   return DM_OK;
 }
 
@@ -681,19 +397,19 @@ static int compile_native(const dm_tape *t, const double *in0,
   const char *cc = getenv("CC");
   char cccopy[1024], *ccargv[32];
   snprintf(cccopy, sizeof cccopy, "%s", cc && *cc ? cc : "cc");
-  int ncc = cc_words(cccopy, ccargv, 30);
+  int ncc = dm_native__cc_words(cccopy, ccargv, 30);
   if (ncc == 0)
     return dm_err_set(err, DM_ENOTFOUND, "native: $CC is blank");
-  int s = make_key(ccargv, ncc, src, nat->key, err);
+  int s = dm_native__make_key(ccargv, ncc, src, nat->key, err);
   if (s != DM_OK)
     return s;
 
   char cdir[4096], cached[4200];
-  int have_cache = cache_dir(cdir, sizeof cdir) == 0;
+  int have_cache = dm_native__cache_dir(cdir, sizeof cdir) == 0;
   if (have_cache) {
     snprintf(cached, sizeof cached, "%s/%s.so", cdir, nat->key);
-    if (trusted_file(cached) && load(cached, nat->key, nat, NULL) == DM_OK) {
-      if (verify(t, nat->fn, in0, par0, NULL) == DM_OK) {
+    if (dm_native__trusted_file(cached) && load(cached, nat->key, nat, NULL) == DM_OK) {
+      if (verify(t, nat, in0, par0, NULL) == DM_OK) {
         nat->cached = 1;
         return DM_OK;
       }
@@ -721,38 +437,68 @@ static int compile_native(const dm_tape *t, const double *in0,
     return dm_err_set(err, DM_EIO, "native: mkdtemp in %s: %s",
                       tmpd && *tmpd ? tmpd : "/tmp", strerror(errno));
   }
-  s = build(ccargv, ncc, dir, full, obj, sizeof obj, err);
+  s = dm_native__build(ccargv, ncc, dir, full, obj, sizeof obj, err);
   free(full);
   if (s == DM_OK) {
-    if (have_cache && cache_store(cdir, cached, obj) == 0 &&
+    if (have_cache && dm_native__cache_store(cdir, cached, obj) == 0 &&
         load(cached, nat->key, nat, NULL) == DM_OK)
       ;
     else
       s = load(obj, nat->key, nat, err);
   }
-  remove_tree(dir);
+  dm_native__remove_tree(dir);
   if (s != DM_OK)
     return s;
-  return verify(t, nat->fn, in0, par0, err);
+  return verify(t, nat, in0, par0, err);
 }
 
-int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
-                      dm_native **natp, dm_err *err)
+static int compile_with(const dm_tape *t, const double *in0,
+                        const double *par0, const dm_native_map *inmap,
+                        size_t nmap, const dm_native_map *outmap,
+                        dm_native **natp, dm_err *err)
 {
   *natp = NULL;
+  for (size_t j = 0; j < nmap; j++)
+    if (outmap[j].k >= dm_tape_nout(t) || outmap[j].arr >= 32)
+      return dm_err_set(err, DM_EINVAL, "native: output map entry %zu out of "
+                        "range", j + 1);
+  for (size_t i = 0; inmap && i < dm_tape_nin(t); i++)
+    if (inmap[i].arr >= 32)
+      return dm_err_set(err, DM_EINVAL, "native: input map entry %zu out of "
+                        "range", i + 1);
   dm_native *nat = calloc(1, sizeof *nat);
-  char *src = dm_native_source(t);
+  char *src = emit(t, inmap, nmap, outmap);
   if (nat == NULL || src == NULL) {
     free(nat);
     free(src);
     return dm_err_set(err, DM_ENOMEM, "native: out of memory");
   }
+  nat->inmap = inmap;
+  nat->outmap = outmap;
+  nat->nmap = nmap;
   int s = compile_native(t, in0, par0, nat, src, err);
   free(src);
+  nat->inmap = nat->outmap = NULL;      /* the caller's: not kept */
   if (s != DM_OK) {
     dm_native_free(nat);
     return s;
   }
   *natp = nat;
   return DM_OK;
+}
+
+int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
+                      dm_native **natp, dm_err *err)
+{
+  return compile_with(t, in0, par0, NULL, 0, NULL, natp, err);
+}
+
+int dm_native_compile_mapped(const dm_tape *t, const double *in0,
+                             const double *par0, const dm_native_map *inmap,
+                             size_t nmap, const dm_native_map *outmap,
+                             dm_native **natp, dm_err *err)
+{
+  if (inmap == NULL || (nmap && outmap == NULL))
+    return dm_err_set(err, DM_EINVAL, "native: maps missing");
+  return compile_with(t, in0, par0, inmap, nmap, outmap, natp, err);
 }

@@ -27,6 +27,7 @@
 #define DM_NATIVE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "status.h"
 #include "tape.h"
@@ -50,6 +51,29 @@ int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
 void dm_native_free(dm_native *nat);
 
 dm_native_fn dm_native_function(const dm_native *nat);
+
+/* Element `elem` of array `arr` (arr < 32), for output `k` or input k. */
+typedef struct dm_native_map {
+  uint32_t k, arr, elem;
+} dm_native_map;
+
+/* Gathers its inputs and scatters its outputs itself: input i is
+ * in[inmap[i].arr][inmap[i].elem]; output k goes to out[arr][elem] for
+ * every outmap entry with that k whose bit (1 << arr) is set in mask.
+ * Returns 1, writing nothing, when any output is NaN or infinite, else 0.
+ * This is what a system callback needs without copying through buffers. */
+typedef int (*dm_native_scatter_fn)(const double *const *in, const double *par,
+                                    double *const *out, unsigned mask);
+
+/* As dm_native_compile, and also emit the scatter function for these maps
+ * (inmap has dm_tape_nin(t) entries; the maps are only read during the
+ * call).  Both functions are checked. */
+int dm_native_compile_mapped(const dm_tape *t, const double *in0,
+                             const double *par0, const dm_native_map *inmap,
+                             size_t nmap, const dm_native_map *outmap,
+                             dm_native **nat, dm_err *err);
+/* The scatter function, or NULL when compiled without maps. */
+dm_native_scatter_fn dm_native_scatter(const dm_native *nat);
 /* 1 if the object came from the cache, 0 if it was compiled now. */
 int dm_native_cached(const dm_native *nat);
 /* The cache key (64 hex digits). */

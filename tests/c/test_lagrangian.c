@@ -221,8 +221,16 @@ static void test_dsp(void)
                                                         fabs(fn.Lqq[i] - f.Lqq[i]))));
     tap_ok(st == DM_OK && ls.native_grad && d <= 1e-15 * 100,
            "DSP native: same values as the tape (max diff %.2g)", d);
+    double badq[8];
+    memcpy(badq, dsp_x, sizeof badq);
+    badq[0] = 1.25;
+    full fb;
+    fb.L = -7;
+    int r = call(&sn, badq, badq + 4, DM_LAG_ALL, &fb);
+    tap_ok(r == 1, "DSP native: r1 > l1 reports a recoverable failure (1)");
   } else {
     tap_ok(st == DM_OK, "# SKIP no C compiler: auto falls back to the tape");
+    tap_ok(st == DM_OK, "# SKIP no C compiler");
   }
   dm_system_release(&sn);
   dm_system_release(&s);
@@ -320,6 +328,31 @@ static void test_force_constraints(void)
   }
   ok = e < 1e-15 && H[5] == H[6];
   tap_ok(ok, "constraints g, G, H (H symmetric per constraint; err %.2g)", e);
+
+  /* the same through native code (it scatters into the arrays itself) */
+  dm_system sn;
+  sp.native = DM_NATIVE_AUTO;
+  st = dm_lagrangian_compile(C, &sp, &sn, &err);
+  dm_lagrangian_stats ls;
+  dm_lagrangian_stats_get(&sn, &ls);
+  if (st == DM_OK && ls.native_all) {
+    double F2[2], Fq2[4], Fv2[4], g2[2], G2[4], H2[8];
+    void *w2 = malloc(sn.work_size);
+    sn.force(sn.data, x, vv, sn.par, DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V, F2, Fq2, Fv2, w2);
+    sn.constraints(sn.data, x, sn.par, DM_CONSTR_G | DM_CONSTR_DG | DM_CONSTR_D2G, g2, G2, H2, w2);
+    int same = memcmp(F2, Fo, sizeof F2) == 0 && memcmp(Fq2, Fq, sizeof Fq) == 0 &&
+               memcmp(Fv2, Fv, sizeof Fv) == 0 && memcmp(g2, go, sizeof go) == 0 &&
+               memcmp(G2, G, sizeof G) == 0 && memcmp(H2, H, sizeof H) == 0;
+    tap_ok(same, "native force and constraint callbacks = tape, bit for bit");
+    double Fonly[2] = { -1, -1 };
+    sn.force(sn.data, x, vv, sn.par, DM_FORCE_F, Fonly, NULL, NULL, w2);
+    tap_ok(Fonly[0] == Fo[0] && Fonly[1] == Fo[1], "F alone: other arrays may be NULL");
+    free(w2);
+  } else {
+    tap_ok(st == DM_OK, "# SKIP no C compiler");
+    tap_ok(st == DM_OK, "# SKIP no C compiler");
+  }
+  dm_system_release(&sn);
   free(w);
   dm_system_release(&s);
 }
