@@ -12,6 +12,9 @@ static const dm_opener openers[] = {
   dm_open_plot,
   dm_open_traj,
   dm_open_expr,
+  dm_open_system,
+  dm_open_builtin,
+  dm_open_integrator,
   NULL
 };
 

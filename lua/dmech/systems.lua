@@ -1,0 +1,220 @@
+-- dmech.systems -- the catalog of example systems: dm.systems.<name>{...}.
+--
+-- Each entry is a function of an optional table of parameters (and a few
+-- options) returning a dm.system whose Lagrangian is written below in plain
+-- Lua, so every one is also an example of dm.system.  The module returns an
+-- installer that the C opener calls with the dm table being built; the
+-- functions use dm only when called.
+return function(dm)
+  local S = {}
+
+  -- Parameters in a fixed order from defaults, overridden by opts; the
+  -- option names in `extra` are returned separately.  Unknown keys raise.
+  local function params(fname, opts, defaults, extra)
+    opts = opts or {}
+    if type(opts) ~= "table" then
+      error(("dm.systems.%s: table of parameters expected, got %s"):format(fname, type(opts)), 3)
+    end
+    local known, list, ex = {}, {}, {}
+    for _, d in ipairs(defaults) do known[d[1]] = true end
+    for _, k in ipairs(extra or {}) do known[k] = true end
+    for k in pairs(opts) do
+      if not known[k] then
+        local names = {}
+        for _, d in ipairs(defaults) do names[#names + 1] = d[1] end
+        for _, e in ipairs(extra or {}) do names[#names + 1] = e end
+        error(("dm.systems.%s: unknown parameter %s (parameters: %s)"):format(fname, tostring(k),
+          table.concat(names, ", ")), 3)
+      end
+    end
+    for _, d in ipairs(defaults) do
+      local v = opts[d[1]]
+      if v == nil then v = d[2] end
+      if type(v) ~= "number" then
+        error(("dm.systems.%s: parameter %s must be a number, got %s"):format(fname, d[1], type(v)), 3)
+      end
+      list[#list + 1] = {d[1], v}
+    end
+    for _, k in ipairs(extra or {}) do ex[k] = opts[k] end
+    return list, ex
+  end
+
+  local function def(name, sig, doc, f)
+    S[name] = f
+    dm.doc("dm.systems." .. name, sig, doc, f)
+  end
+
+  local function sq(x) return x * x end
+
+  def("harmonic", "dm.systems.harmonic{omega=1, m=1} -> system",
+    "Harmonic oscillator L = m v^2/2 - m omega^2 x^2/2 (coordinate x): Gauss methods rotate (omega x, p/m) exactly by a modified angle, Stormer-Verlet is stable for h omega < 2.",
+    function(o)
+      local p = params("harmonic", o, {{"m", 1}, {"omega", 1}})
+      return dm.system{name = "harmonic oscillator", coords = {"x"}, params = p,
+        L = function(q, v, p) return 0.5 * p.m * (v.x^2 - p.omega^2 * q.x^2) end}
+    end)
+
+  def("damped", "dm.systems.damped{omega=1, c=0.1, m=1} -> system",
+    "Damped oscillator: L = m v^2/2 - m omega^2 x^2/2 with the Lagrange-d'Alembert force F = -c v; for light damping the energy decays like E0 exp(-c t/m).",
+    function(o)
+      local p = params("damped", o, {{"m", 1}, {"omega", 1}, {"c", 0.1}})
+      return dm.system{name = "damped oscillator", coords = {"x"}, params = p,
+        L = function(q, v, p) return 0.5 * p.m * (v.x^2 - p.omega^2 * q.x^2) end,
+        force = function(q, v, p) return {-p.c * v.x} end}
+    end)
+
+  def("pendulum", "dm.systems.pendulum{g=9.81, l=1, m=1} -> system",
+    "Planar pendulum, angle theta from the downward vertical: L = m l^2 thetadot^2/2 + m g l cos(theta) (g = l = m = 1 is the test problem of spec T2.2).",
+    function(o)
+      local p = params("pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
+      return dm.system{name = "pendulum", coords = {"theta"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * p.m * p.l^2 * v.theta^2 + p.m * p.g * p.l * dm.cos(q.theta)
+        end}
+    end)
+
+  def("kepler", "dm.systems.kepler{mu=1, dim=2} -> system",
+    "Kepler problem in Cartesian coordinates (x, y[, z]): L = |v|^2/2 + mu/|q|; energy, angular momentum and the Runge-Lenz vector are conserved (e = 0.6: q = (0.4, 0), p = (0, 2), period 2 pi).",
+    function(o)
+      local p, ex = params("kepler", o, {{"mu", 1}}, {"dim"})
+      local dim = ex.dim or 2
+      if dim ~= 2 and dim ~= 3 then error("dm.systems.kepler: dim must be 2 or 3", 2) end
+      local coords = dim == 2 and {"x", "y"} or {"x", "y", "z"}
+      return dm.system{name = "Kepler (Cartesian)", coords = coords, params = p,
+        L = function(q, v, p)
+          local T, r2 = 0, 0
+          for i = 1, dim do T = T + v[i]^2; r2 = r2 + q[i]^2 end
+          return 0.5 * T + p.mu / dm.sqrt(r2)
+        end}
+    end)
+
+  def("kepler_polar", "dm.systems.kepler_polar{mu=1} -> system",
+    "Kepler problem in polar coordinates (r, theta): L = (rdot^2 + r^2 thetadot^2)/2 + mu/r; theta is cyclic, its momentum r^2 thetadot is the angular momentum.",
+    function(o)
+      local p = params("kepler_polar", o, {{"mu", 1}})
+      return dm.system{name = "Kepler (polar)", coords = {"r", "theta"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * (v.r^2 + q.r^2 * v.theta^2) + p.mu / q.r
+        end}
+    end)
+
+  -- the corrected J2 potential of spec routh.md section 8
+  local function j2_potential(R2, z, J2)
+    local R = dm.sqrt(R2)
+    return -1 / R + J2 / R^3 * (1.5 * z^2 / R2 - 0.5)
+  end
+
+  def("j2", "dm.systems.j2{J2=0.05} -> system",
+    "J2 satellite in Cartesian (x, y, z), non-dimensional (Earth radius 1): L = |v|^2/2 - V, V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (the corrected potential of spec routh.md 8); the z angular momentum is conserved.",
+    function(o)
+      local p = params("j2", o, {{"J2", 0.05}})
+      return dm.system{name = "J2 satellite (Cartesian)", coords = {"x", "y", "z"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * (v.x^2 + v.y^2 + v.z^2) - j2_potential(q.x^2 + q.y^2 + q.z^2, q.z, p.J2)
+        end}
+    end)
+
+  def("j2_cylindrical", "dm.systems.j2_cylindrical{J2=0.05} -> system",
+    "J2 satellite in cylindrical (r, theta, z): L = (rdot^2 + r^2 thetadot^2 + zdot^2)/2 - V(r, z) with the corrected potential; theta is cyclic (J = r^2 thetadot), the reduced Routhian is (rdot^2 + zdot^2)/2 - V - mu^2/(2 r^2).",
+    function(o)
+      local p = params("j2_cylindrical", o, {{"J2", 0.05}})
+      return dm.system{name = "J2 satellite (cylindrical)", coords = {"r", "theta", "z"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * (v.r^2 + q.r^2 * v.theta^2 + v.z^2) - j2_potential(q.r^2 + q.z^2, q.z, p.J2)
+        end}
+    end)
+
+  def("henon_heiles", "dm.systems.henon_heiles{lambda=1} -> system",
+    "Henon-Heiles system: L = (xdot^2 + ydot^2)/2 - (x^2 + y^2)/2 - lambda (x^2 y - y^3/3); bounded motion below the escape energy 1/(6 lambda^2), chaotic near it.",
+    function(o)
+      local p = params("henon_heiles", o, {{"lambda", 1}})
+      return dm.system{name = "Henon-Heiles", coords = {"x", "y"}, params = p,
+        L = function(q, v, p)
+          local x, y = q.x, q.y
+          return 0.5 * (v.x^2 + v.y^2) - 0.5 * (x^2 + y^2) - p.lambda * (x^2 * y - y^3 / 3)
+        end}
+    end)
+
+  def("spherical_pendulum", "dm.systems.spherical_pendulum{g=9.81, l=1, m=1} -> system",
+    "Spherical pendulum in spherical coordinates (theta from the downward vertical, phi azimuth): L = m l^2 (thetadot^2 + sin^2(theta) phidot^2)/2 + m g l cos(theta); phi is cyclic (the vertical angular momentum m l^2 sin^2(theta) phidot).",
+    function(o)
+      local p = params("spherical_pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
+      return dm.system{name = "spherical pendulum", coords = {"theta", "phi"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * p.m * p.l^2 * (v.theta^2 + dm.sin(q.theta)^2 * v.phi^2)
+            + p.m * p.g * p.l * dm.cos(q.theta)
+        end}
+    end)
+
+  def("spherical_pendulum_r3", "dm.systems.spherical_pendulum_r3{g=9.81, l=1, m=1, form=\"squared\"} -> system",
+    "Spherical pendulum in R^3 (x, y, z) with the holonomic constraint |q|^2 - l^2 = 0 (form=\"norm\": |q| - l = 0): L = m |v|^2/2 - m g z; integrated with Lagrange multipliers (RATTLE, or multipliers at every stage).",
+    function(o)
+      local p, ex = params("spherical_pendulum_r3", o, {{"g", 9.81}, {"l", 1}, {"m", 1}}, {"form"})
+      local form = ex.form or "squared"
+      if form ~= "squared" and form ~= "norm" then
+        error("dm.systems.spherical_pendulum_r3: form must be \"squared\" or \"norm\"", 2)
+      end
+      return dm.system{name = "spherical pendulum (R3)", coords = {"x", "y", "z"}, params = p,
+        L = function(q, v, p)
+          return 0.5 * p.m * (v.x^2 + v.y^2 + v.z^2) - p.m * p.g * q.z
+        end,
+        constraints = function(q, p)
+          local r2 = q.x^2 + q.y^2 + q.z^2
+          if form == "norm" then return dm.sqrt(r2) - p.l end
+          return r2 - p.l^2
+        end}
+    end)
+
+  local dsp_params = {{"g", 9.81}, {"l1", 1}, {"l2", 1}, {"m1", 1}, {"m2", 1}}
+
+  def("double_spherical_pendulum",
+    "dm.systems.double_spherical_pendulum{g=9.81, l1=1, l2=1, m1=1, m2=1, form=\"cylindrical\"|\"shape\"} -> system",
+    "Double spherical pendulum (spec routh.md 9) in cylindrical coordinates of each bob relative to its pivot, hanging below (z_i = -sqrt(l_i^2 - r_i^2)): coords r1, theta1, r2, theta2, or with form=\"shape\" theta, r1, r2, phi (theta1 = theta, theta2 = theta + phi; theta cyclic for the simultaneous rotation). L = m1|q1dot|^2/2 + m2|q1dot + q2dot|^2/2 - m1 g z1 - m2 g (z1 + z2).",
+    function(o)
+      local p, ex = params("double_spherical_pendulum", o, dsp_params, {"form"})
+      local shape = (ex.form or "cylindrical") == "shape"
+      if ex.form and ex.form ~= "shape" and ex.form ~= "cylindrical" then
+        error("dm.systems.double_spherical_pendulum: form must be \"cylindrical\" or \"shape\"", 2)
+      end
+      -- position and velocity of one bob relative to its pivot
+      local function bob(r, th, rd, thd, l)
+        local s = dm.sqrt(l^2 - r^2)
+        local c, sn = dm.cos(th), dm.sin(th)
+        return {r * c, r * sn, -s}, {rd * c - r * sn * thd, rd * sn + r * c * thd, r * rd / s}
+      end
+      return dm.system{name = "double spherical pendulum", params = p,
+        coords = shape and {"theta", "r1", "r2", "phi"} or {"r1", "theta1", "r2", "theta2"},
+        L = function(q, v, p)
+          local th1, th2, th1d, th2d
+          if shape then
+            th1, th2, th1d, th2d = q.theta, q.theta + q.phi, v.theta, v.theta + v.phi
+          else
+            th1, th2, th1d, th2d = q.theta1, q.theta2, v.theta1, v.theta2
+          end
+          local x1, w1 = bob(q.r1, th1, v.r1, th1d, p.l1)
+          local x2, w2 = bob(q.r2, th2, v.r2, th2d, p.l2)
+          local T = 0.5 * p.m1 * (sq(w1[1]) + sq(w1[2]) + sq(w1[3]))
+            + 0.5 * p.m2 * (sq(w1[1] + w2[1]) + sq(w1[2] + w2[2]) + sq(w1[3] + w2[3]))
+          return T - p.m1 * p.g * x1[3] - p.m2 * p.g * (x1[3] + x2[3])
+        end}
+    end)
+
+  def("double_spherical_pendulum_r3",
+    "dm.systems.double_spherical_pendulum_r3{g=9.81, l1=1, l2=1, m1=1, m2=1} -> system",
+    "Double spherical pendulum in R^3 x R^3 (coords x1, y1, z1 of the first bob from the pivot, x2, y2, z2 of the second from the first) with the constraints |q1| - l1 = 0, |q2| - l2 = 0 (spec routh.md 9, constrained variant).",
+    function(o)
+      local p = params("double_spherical_pendulum_r3", o, dsp_params)
+      return dm.system{name = "double spherical pendulum (R3xR3)", params = p,
+        coords = {"x1", "y1", "z1", "x2", "y2", "z2"},
+        L = function(q, v, p)
+          local T1 = v.x1^2 + v.y1^2 + v.z1^2
+          local T2 = sq(v.x1 + v.x2) + sq(v.y1 + v.y2) + sq(v.z1 + v.z2)
+          return 0.5 * p.m1 * T1 + 0.5 * p.m2 * T2 - p.m1 * p.g * q.z1 - p.m2 * p.g * (q.z1 + q.z2)
+        end,
+        constraints = function(q, p)
+          return {dm.sqrt(q.x1^2 + q.y1^2 + q.z1^2) - p.l1, dm.sqrt(q.x2^2 + q.y2^2 + q.z2^2) - p.l2}
+        end}
+    end)
+
+  dm.systems = S
+end

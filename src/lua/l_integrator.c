@@ -1,0 +1,547 @@
+/* l_integrator.c -- dm.integrator(sys, {method=, h=, ...}): options mapped
+ * by name through dm_integ_options, user PRK tableaus, states read from
+ * tables, one step, the discrete Legendre transforms, DEL steps, discrete
+ * momentum and the structure diagnostics (symplecticity defect, time
+ * reversal, step Jacobian).  integ:run lives in l_integ_run.c, dm.tableau
+ * and dm.order_estimate in l_integ_diag.c.  See l_integ.h. */
+#include <config.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "l_integ.h"
+
+/* {======================================================================
+ * life cycle
+ * ======================================================================= */
+
+static void integ_release(dm_linteg *li)
+{
+  dm_integrator_free(li->I);
+  free(li->buf);
+  li->I = NULL;
+  li->buf = NULL;
+}
+
+static int integ_gc(lua_State *L)
+{
+  integ_release(luaL_checkudata(L, 1, DM_INTEG_MT));
+  return 0;
+}
+
+static void build(lua_State *L, dm_linteg *li, const char *fname)
+{
+  dm_integrator *I;
+  dm_err e;
+  int st = dm_integrator_new(&li->ls->sys, li->method, &li->opt, &I, &e);
+  if (st != DM_OK)
+    dm_lua_fail(L, fname, st, &e);
+  dm_integrator_free(li->I);
+  li->I = I;
+  li->gen = li->ls->gen;
+}
+
+dm_linteg *dm_linteg_check(lua_State *L, int idx)
+{
+  dm_linteg *li = luaL_checkudata(L, idx, DM_INTEG_MT);
+  if (li->I == NULL)
+    luaL_error(L, "attempt to use a closed integrator");
+  if (li->gen != li->ls->gen)
+    build(L, li, "integrator (rebuilt after a parameter change)");
+  return li;
+}
+
+/* dm.integrator(sys, {method=, h=, ...}) */
+static int l_integrator(lua_State *L)
+{
+  dm_lsystem *ls = dm_lua_checksystem(L, 1);
+  const char *method;
+  double h;
+  if (lua_isnoneornil(L, 2)) {
+    lua_settop(L, 1);
+    lua_newtable(L);
+  }
+  luaL_checktype(L, 2, LUA_TTABLE);
+  lua_settop(L, 2);
+  dm_linteg *li = lua_newuserdatauv(L, sizeof *li, 2);        /* 3 */
+  memset(li, 0, sizeof *li);
+  luaL_setmetatable(L, DM_INTEG_MT);
+  lua_pushvalue(L, 1);
+  lua_setiuservalue(L, 3, 1);
+  li->ls = ls;
+  dm_linteg_parse(L, 2, "dm.integrator", NULL, &li->opt, &method, &h);   /* 4: box */
+  lua_setiuservalue(L, 3, 2);
+  if (strlen(method) >= sizeof li->method)
+    return luaL_error(L, "dm.integrator: method name too long");
+  strcpy(li->method, method);
+  li->h = h;
+  if ((li->buf = calloc(10 * ls->n, sizeof *li->buf)) == NULL)
+    return luaL_error(L, "out of memory");
+  build(L, li, "dm.integrator");
+  lua_settop(L, 3);
+  return 1;
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * states
+ * ======================================================================= */
+
+double dm_linteg_h(lua_State *L, dm_linteg *li, int idx)
+{
+  double h = li->h;
+  if (!lua_isnoneornil(L, idx)) {
+    h = luaL_checknumber(L, idx);
+    if (h == 0.0 || !isfinite(h))
+      luaL_argerror(L, idx, "finite non-zero step size expected");
+  }
+  if (isnan(h))
+    luaL_error(L, "no step size: give h in dm.integrator(sys, {h = ...}), set integ.h, or pass "
+               "it to this call");
+  return h;
+}
+
+static void check_finite(lua_State *L, const double *x, size_t n, const char *fname,
+                         const char *what)
+{
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(x[i]))
+      luaL_error(L, "%s: state.%s contains NaN or Inf (component %d = %f)", fname, what,
+                 (int)i + 1, x[i]);
+}
+
+void dm_lua_readstate(lua_State *L, dm_lsystem *ls, dm_integrator *I, int idx,
+                      const char *fname, double *buf, dm_lstate *s)
+{
+  size_t n = ls->n;
+  char what[96];
+  dm_err e;
+  int st, have_p;
+  idx = lua_absindex(L, idx);
+  s->q = buf;
+  s->p = buf + n;
+  s->v = buf + 2 * n;
+  if (lua_type(L, idx) != LUA_TTABLE)
+    luaL_error(L, "%s: state {q = ..., p = ...} or {q = ..., v = ...} expected, got %s", fname,
+               luaL_typename(L, idx));
+  if (lua_getfield(L, idx, "q") == LUA_TNIL)
+    luaL_error(L, "%s: the state has no field 'q' (coordinates)", fname);
+  snprintf(what, sizeof what, "%s: state.q", fname);
+  dm_lua_system_readvec(L, ls, -1, what, s->q);
+  lua_pop(L, 1);
+  check_finite(L, s->q, n, fname, "q");
+  s->t = 0.0;
+  if (lua_getfield(L, idx, "t") != LUA_TNIL) {
+    if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+      luaL_error(L, "%s: state.t must be a finite number, got %s", fname,
+                 luaL_tolstring(L, -1, NULL));
+    s->t = lua_tonumber(L, -1);
+  }
+  lua_pop(L, 1);
+  have_p = lua_getfield(L, idx, "p") != LUA_TNIL;
+  if (!have_p) {
+    lua_pop(L, 1);
+    if (lua_getfield(L, idx, "v") == LUA_TNIL)
+      luaL_error(L, "%s: the state needs momenta p or velocities v besides q", fname);
+  }
+  snprintf(what, sizeof what, "%s: state.%s", fname, have_p ? "p" : "v");
+  dm_lua_system_readvec(L, ls, -1, what, have_p ? s->p : s->v);
+  lua_pop(L, 1);
+  check_finite(L, have_p ? s->p : s->v, n, fname, have_p ? "p" : "v");
+  if (!have_p) {
+    if ((st = dm_integrator_momentum(I, s->q, s->v, s->p, &e)) != DM_OK)
+      dm_lua_fail(L, fname, st, &e);
+    check_finite(L, s->p, n, fname, "p (from the Legendre map)");
+    memcpy(buf + 3 * n, s->v, n * sizeof *buf);
+    st = dm_integrator_velocity(I, s->q, s->p, buf + 3 * n, 1, &e);
+  } else {
+    st = dm_integrator_velocity(I, s->q, s->p, s->v, 0, &e);
+  }
+  if (st != DM_OK)
+    dm_lua_fail(L, fname, st, &e);
+}
+
+void dm_linteg_readstate(lua_State *L, dm_linteg *li, int idx, const char *fname,
+                         dm_lstate *s)
+{
+  dm_lua_readstate(L, li->ls, li->I, idx, fname, li->buf, s);
+}
+
+void dm_linteg_pushstate(lua_State *L, const dm_linteg *li, double t, const double *q,
+                         const double *p, const double *v)
+{
+  size_t n = li->ls->n;
+  lua_createtable(L, 0, 4);
+  lua_pushnumber(L, t);
+  lua_setfield(L, -2, "t");
+  dm_pushvec_copy(L, q, n);
+  lua_setfield(L, -2, "q");
+  dm_pushvec_copy(L, p, n);
+  lua_setfield(L, -2, "p");
+  if (v != NULL) {
+    dm_pushvec_copy(L, v, n);
+    lua_setfield(L, -2, "v");
+  }
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * one step, discrete Legendre transforms, DEL, discrete momentum
+ * ======================================================================= */
+
+/* Expected numerical failures (Newton, domain) return nil, message. */
+static int soft_fail(lua_State *L, const char *fname, int st, const dm_err *e)
+{
+  if (st == DM_ENOCONV || st == DM_EDOM || st == DM_ESINGULAR) {
+    lua_pushnil(L);
+    lua_pushfstring(L, "%s: %s", fname, e->msg[0] ? e->msg : dm_strstatus(st));
+    return 2;
+  }
+  return dm_lua_fail(L, fname, st, e);
+}
+
+static int i_step(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 3);
+  size_t n = li->ls->n;
+  double *q1 = li->buf + 4 * n, *p1 = q1 + n, *v1 = p1 + n;
+  dm_lstate s;
+  dm_err e;
+  int st;
+  dm_linteg_readstate(L, li, 2, "step", &s);
+  if ((st = dm_integrator_step(li->I, h, s.q, s.p, q1, p1, &e)) != DM_OK)
+    return soft_fail(L, "step", st, &e);
+  memcpy(v1, s.v, n * sizeof *v1);
+  if ((st = dm_integrator_velocity(li->I, q1, p1, v1, 1, &e)) != DM_OK)
+    return soft_fail(L, "step", st, &e);
+  dm_linteg_pushstate(L, li, s.t + h, q1, p1, v1);
+  return 1;
+}
+
+static int i_defect(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 3), d;
+  dm_lstate s;
+  dm_err e;
+  int st;
+  dm_linteg_readstate(L, li, 2, "symplecticity_defect", &s);
+  if ((st = dm_integrator_symplecticity_defect(li->I, h, s.q, s.p, &d, &e)) != DM_OK)
+    return dm_lua_fail(L, "symplecticity_defect", st, &e);
+  lua_pushnumber(L, d);
+  return 1;
+}
+
+static int i_jacobian(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 3);
+  size_t N = 2 * li->ls->n;
+  dm_lstate s;
+  dm_err e;
+  int st;
+  dm_linteg_readstate(L, li, 2, "jacobian", &s);
+  gsl_matrix *D = dm_pushmat(L, N, N);
+  if ((st = dm_integrator_jacobian(li->I, h, s.q, s.p, D->data, &e)) != DM_OK)
+    return dm_lua_fail(L, "jacobian", st, &e);
+  return 1;
+}
+
+static int i_reversal(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  lua_Integer k = luaL_checkinteger(L, 3);
+  double h = dm_linteg_h(L, li, 4), d;
+  dm_lstate s;
+  dm_err e;
+  int st;
+  luaL_argcheck(L, k >= 1, 3, "number of steps >= 1 expected");
+  dm_linteg_readstate(L, li, 2, "reversal", &s);
+  if ((st = dm_integrator_reversal(li->I, h, (long)k, s.q, s.p, &d, &e)) != DM_OK)
+    return soft_fail(L, "reversal", st, &e);
+  lua_pushnumber(L, d);
+  return 1;
+}
+
+/* q0, q1 from arguments 2, 3 into buf[0..2n). */
+static void read_q0q1(lua_State *L, dm_linteg *li, const char *fname)
+{
+  char what[64];
+  size_t n = li->ls->n;
+  snprintf(what, sizeof what, "%s: q0", fname);
+  dm_lua_system_readvec(L, li->ls, 2, what, li->buf);
+  snprintf(what, sizeof what, "%s: q1", fname);
+  dm_lua_system_readvec(L, li->ls, 3, what, li->buf + n);
+  check_finite(L, li->buf, 2 * n, fname, "q0/q1");
+}
+
+static int i_dlegendre(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 4), Ld;
+  size_t n = li->ls->n;
+  dm_err e;
+  int st;
+  read_q0q1(L, li, "dlegendre");
+  double *p0 = li->buf + 2 * n, *p1 = p0 + n;
+  if ((st = dm_integrator_dlegendre(li->I, h, li->buf, li->buf + n, p0, p1, &Ld, &e)) != DM_OK)
+    return soft_fail(L, "dlegendre", st, &e);
+  dm_pushvec_copy(L, p0, n);
+  dm_pushvec_copy(L, p1, n);
+  lua_pushnumber(L, Ld);
+  return 3;
+}
+
+static int i_del_step(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 4);
+  size_t n = li->ls->n;
+  dm_err e;
+  int st;
+  read_q0q1(L, li, "del_step");
+  double *q2 = li->buf + 2 * n;
+  if ((st = dm_integrator_del_step(li->I, h, li->buf, li->buf + n, q2, &e)) != DM_OK)
+    return soft_fail(L, "del_step", st, &e);
+  dm_pushvec_copy(L, q2, n);
+  return 1;
+}
+
+/* integ:discrete_momentum(q0, q1, coord | xi[, h]) */
+static int i_discrete_momentum(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  double h = dm_linteg_h(L, li, 5), J;
+  size_t n = li->ls->n;
+  double *xi = li->buf + 2 * n;
+  dm_err e;
+  int st;
+  read_q0q1(L, li, "discrete_momentum");
+  if (lua_type(L, 4) == LUA_TSTRING) {
+    long i = dm_lua_system_coord(li->ls, lua_tostring(L, 4));
+    if (i < 0)
+      return luaL_error(L, "discrete_momentum: no coordinate '%s' in system '%s'",
+                        lua_tostring(L, 4), li->ls->sys.name);
+    memset(xi, 0, n * sizeof *xi);
+    xi[i] = 1.0;
+  } else if (!lua_isnoneornil(L, 4)) {
+    dm_lua_system_readvec(L, li->ls, 4, "discrete_momentum: xi", xi);
+  } else {
+    return luaL_argerror(L, 4, "coordinate name or direction xi expected");
+  }
+  if ((st = dm_integrator_discrete_momentum(li->I, h, li->buf, li->buf + n, xi, &J, &e)) != DM_OK)
+    return soft_fail(L, "discrete_momentum", st, &e);
+  lua_pushnumber(L, J);
+  return 1;
+}
+
+static int i_reset(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  dm_integrator_reset(li->I);
+  lua_settop(L, 1);
+  return 1;
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * fields and metamethods
+ * ======================================================================= */
+
+/* The number of stages actually used (0 when the notion does not apply). */
+static int actual_stages(const dm_linteg *li)
+{
+  const char *m = li->I->type->name;
+  if (strcmp(m, "midpoint") == 0)
+    return 1;
+  if (strcmp(m, "trapezoid") == 0)
+    return 2;
+  if (strcmp(m, "prk") == 0 && li->opt.tableau)
+    return (int)li->opt.tableau->s;
+  if (strcmp(m, "gauss") == 0)
+    return li->opt.stages ? li->opt.stages : li->I->order / 2;
+  if (strcmp(m, "lobatto") == 0)
+    return li->opt.stages ? li->opt.stages : li->I->order / 2 + 1;
+  return 0;
+}
+
+static void push_stats(lua_State *L, const dm_integ_stats *s)
+{
+  lua_createtable(L, 0, 6);
+  lua_pushinteger(L, s->iters);
+  lua_setfield(L, -2, "iters");
+  lua_pushinteger(L, s->jacs);
+  lua_setfield(L, -2, "jacs");
+  lua_pushnumber(L, s->residual);
+  lua_setfield(L, -2, "residual");
+  lua_pushnumber(L, s->tol);
+  lua_setfield(L, -2, "tol");
+  lua_pushinteger(L, s->steps);
+  lua_setfield(L, -2, "steps");
+  lua_pushinteger(L, s->iters_total);
+  lua_setfield(L, -2, "iters_total");
+}
+
+static int flag_field(lua_State *L, const dm_linteg *li, const char *k)
+{
+  static const struct { const char *name; unsigned bit; } flags[] = {
+    {"symplectic", DM_INTEG_SYMPLECTIC}, {"symmetric", DM_INTEG_SYMMETRIC},
+    {"explicit", DM_INTEG_EXPLICIT}, {"variational", DM_INTEG_VARIATIONAL},
+    {"exact_jacobian", DM_INTEG_EXACT_JAC}
+  };
+  for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++)
+    if (strcmp(k, flags[i].name) == 0) {
+      lua_pushboolean(L, (li->I->flags & flags[i].bit) != 0);
+      return 1;
+    }
+  return 0;
+}
+
+static int integ_index(lua_State *L)
+{
+  const char *k = luaL_checkstring(L, 2);
+  if (lua_getfield(L, lua_upvalueindex(1), k) != LUA_TNIL)
+    return 1;
+  dm_linteg *li = dm_linteg_check(L, 1);
+  if (strcmp(k, "h") == 0) {
+    if (isnan(li->h))
+      lua_pushnil(L);
+    else
+      lua_pushnumber(L, li->h);
+  } else if (strcmp(k, "method") == 0) {
+    lua_pushstring(L, li->method);
+  } else if (strcmp(k, "stages") == 0) {
+    int s = actual_stages(li);
+    if (s > 0)
+      lua_pushinteger(L, s);
+    else
+      lua_pushnil(L);
+  } else if (strcmp(k, "order") == 0) {
+    lua_pushinteger(L, li->I->order);
+  } else if (strcmp(k, "system") == 0) {
+    lua_getiuservalue(L, 1, 1);
+  } else if (strcmp(k, "stats") == 0) {
+    push_stats(L, &li->I->stats);
+  } else if (strcmp(k, "summary") == 0) {
+    lua_pushstring(L, li->I->type->summary);
+  } else if (!flag_field(L, li, k)) {
+    return luaL_error(L, "integrator has no field or method '%s' (fields: h, method, stages, "
+                      "order, system, stats, summary, symplectic, symmetric, explicit, "
+                      "variational, exact_jacobian)", k);
+  }
+  return 1;
+}
+
+static int integ_newindex(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  const char *k = luaL_checkstring(L, 2);
+  double h;
+  if (strcmp(k, "h") != 0)
+    return luaL_error(L, "integrator field '%s' is read-only (only h can be set)", k);
+  h = lua_tonumber(L, 3);
+  if (lua_type(L, 3) != LUA_TNUMBER || h == 0.0 || !isfinite(h))
+    return luaL_error(L, "integ.h must be a finite non-zero number, got %s",
+                      luaL_tolstring(L, 3, NULL));
+  li->h = h;
+  li->opt.h = h;
+  return 0;
+}
+
+static int integ_tostring(lua_State *L)
+{
+  dm_linteg *li = luaL_checkudata(L, 1, DM_INTEG_MT);
+  luaL_Buffer b;
+  char num[32];
+  int s;
+  if (li->I == NULL) {
+    lua_pushliteral(L, "<integrator (closed)>");
+    return 1;
+  }
+  luaL_buffinit(L, &b);
+  lua_pushfstring(L, "<integrator %s", li->method);
+  luaL_addvalue(&b);
+  if ((s = actual_stages(li)) > 0 && strcmp(li->method, "midpoint") != 0 &&
+      strcmp(li->method, "trapezoid") != 0) {
+    lua_pushfstring(L, " s=%d", s);
+    luaL_addvalue(&b);
+  }
+  lua_pushfstring(L, " order %d", li->I->order);
+  luaL_addvalue(&b);
+  if (!isnan(li->h)) {
+    dm_fmtnum(num, sizeof num, li->h);
+    luaL_addstring(&b, " h=");
+    luaL_addstring(&b, num);
+  }
+  lua_pushfstring(L, " on '%s' (%s%s%s)>", li->ls->sys.name,
+                  (li->I->flags & DM_INTEG_EXPLICIT) ? "explicit" : "implicit",
+                  (li->I->flags & DM_INTEG_SYMPLECTIC) ? ", symplectic" : "",
+                  (li->I->flags & DM_INTEG_SYMMETRIC) ? ", symmetric" : "");
+  luaL_addvalue(&b);
+  luaL_pushresult(&b);
+  return 1;
+}
+
+/* }====================================================================== */
+
+static const luaL_Reg integ_meta[] = {
+  {"__gc", integ_gc}, {"__close", integ_gc}, {"__tostring", integ_tostring},
+  {"__newindex", integ_newindex}, {NULL, NULL}
+};
+
+static const dm_reg integ_methods[] = {
+  {"step", i_step, "integ:step(state[, h]) -> state | nil, message",
+   "One step from {q=, p=} or {q=, v=} (t optional) to a new state {t, q, p, v}; a Newton "
+   "failure returns nil and a message with the residual and tolerance."},
+  {"run", dm_linteg_run,
+   "integ:run(state, {steps= | t=, every=1, progress=, energy=true, momentum={coords}}) -> traj[, message]",
+   "Integrate in C and record every `every` steps a Trajectory with t, q, p, v, energy and "
+   "momentum columns; Ctrl-C or a failure (Newton, NaN) returns the trajectory so far and a "
+   "message saying at which step and time it stopped (and the residual and tolerance)."},
+  {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
+   "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
+   "step equations (exact Jacobians)."},
+  {"jacobian", i_jacobian, "integ:jacobian(state[, h]) -> mat",
+   "The 2n x 2n Jacobian D(q1, p1)/D(q0, p0) of one step at the state."},
+  {"reversal", i_reversal, "integ:reversal(state, n[, h]) -> number",
+   "Take n steps with h, then n with -h, and return the max-norm distance from the start "
+   "(round-off for symmetric methods)."},
+  {"dlegendre", i_dlegendre, "integ:dlegendre(q0, q1[, h]) -> p0, p1, Ld",
+   "Discrete Legendre transforms p0 = -D1 Ld(q0, q1), p1 = D2 Ld(q0, q1) and the discrete "
+   "Lagrangian of a variational method."},
+  {"del_step", i_del_step, "integ:del_step(q0, q1[, h]) -> q2",
+   "One step of the discrete Euler-Lagrange equations in two-point form."},
+  {"discrete_momentum", i_discrete_momentum,
+   "integ:discrete_momentum(q0, q1, coord | xi[, h]) -> number",
+   "The discrete momentum J_d = xi . D2 Ld(q0, q1) along a coordinate or a direction xi "
+   "(conserved by DEL when Ld is invariant)."},
+  {"reset", i_reset, "integ:reset() -> integ",
+   "Forget the step history (predictor, compensated-summation carries) and the statistics."},
+  {NULL, NULL, NULL, NULL}
+};
+
+static const dm_reg integ_funcs[] = {
+  {"integrator", l_integrator,
+   "dm.integrator(sys, {method=\"gauss\", stages=, h=, tol=, maxiter=, simplified=, order=, "
+   "scheme=, base=, explicit=, tableau=, adaptive=, epsabs=, epsrel=}) -> integ",
+   "A one-step integrator for a system; methods midpoint, gauss, trapezoid (Stormer-Verlet), "
+   "lobatto, prk (tableau={a=, b=[, at=, bt=, c=]}, symplecticity checked), composition, rk4 "
+   "and gsl:<stepper>; an option that does not apply to the method is an error."},
+  {NULL, NULL, NULL, NULL}
+};
+
+void dm_open_integrator(lua_State *L)
+{
+  dm_linteg_open_opts(L);
+  dm_newclass(L, DM_INTEG_MT, "integrator", integ_methods, integ_meta);
+  lua_getfield(L, -1, "__methods");
+  lua_pushcclosure(L, integ_index, 1);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+  dm_register(L, "dm.", integ_funcs);
+  dm_register(L, "dm.", dm_linteg_diag_funcs);
+}

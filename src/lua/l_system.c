@@ -1,0 +1,487 @@
+/* l_system.c -- dm.system{...}: a Lagrangian written as a Lua function,
+ * traced once with symbolic vectors and compiled (dm_lagrangian_compile) to
+ * a dm_system; conversions (momentum, velocity, energy), parameters
+ * settable after creation, the expressions as printable values.  The
+ * userdata layout is shared with other bindings through l_system.h. */
+#include <config.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "l_system.h"
+#include "l_expr.h"
+#include "core/lagrangian.h"
+#include "core/native.h"
+
+
+/* {======================================================================
+ * life cycle
+ * ======================================================================= */
+
+static void system_release(dm_lsystem *ls)
+{
+  dm_integrator_free(ls->conv);
+  dm_system_release(&ls->sys);
+  free(ls->q);
+  free(ls->v);
+  free(ls->par);
+  free(ls->force);
+  free(ls->constr);
+  free(ls->cyclic);
+  free(ls->buf);
+  memset(ls, 0, sizeof *ls);
+  ls->L = DM_EXPR_NONE;
+}
+
+int dm_lsystem_gc(lua_State *L)
+{
+  system_release(luaL_checkudata(L, 1, DM_SYSTEM_MT));
+  return 0;
+}
+
+dm_lsystem *dm_lua_system_new(lua_State *L)
+{
+  dm_lsystem *ls = lua_newuserdatauv(L, sizeof *ls, 1);
+  memset(ls, 0, sizeof *ls);
+  ls->L = DM_EXPR_NONE;
+  luaL_setmetatable(L, DM_SYSTEM_MT);
+  return ls;
+}
+
+dm_lsystem *dm_lua_tosystem(lua_State *L, int idx)
+{
+  dm_lsystem *ls = luaL_testudata(L, idx, DM_SYSTEM_MT);
+  return ls != NULL && ls->sys.lagrangian != NULL ? ls : NULL;
+}
+
+dm_lsystem *dm_lua_checksystem(lua_State *L, int idx)
+{
+  dm_lsystem *ls = dm_lua_tosystem(L, idx);
+  if (ls == NULL)
+    dm_argexpected(L, idx, "system", luaL_typename(L, idx));
+  return ls;
+}
+
+dm_lsystem *dm_lua_checktraced(lua_State *L, int idx, const char *what)
+{
+  dm_lsystem *ls = dm_lua_checksystem(L, idx);
+  if (!ls->traced)
+    luaL_error(L, "%s needs a system defined by a Lagrangian (dm.system{...}); '%s' is a "
+               "built-in C system without expressions", what, ls->sys.name);
+  return ls;
+}
+
+void dm_lua_system_finish(lua_State *L, dm_lsystem *ls, const char *const *cyclic)
+{
+  dm_err e;
+  int st;
+  ls->n = ls->sys.n;
+  ls->npar = ls->sys.npar;
+  ls->m = ls->sys.m;
+  if (ls->cyclic == NULL && (ls->cyclic = calloc(ls->n, 1)) == NULL)
+    luaL_error(L, "out of memory");
+  for (; cyclic != NULL && *cyclic != NULL; cyclic++) {
+    long i = dm_lua_system_coord(ls, *cyclic);
+    if (i >= 0)
+      ls->cyclic[i] = 1;
+  }
+  if ((ls->buf = calloc(6 * ls->n, sizeof *ls->buf)) == NULL)
+    luaL_error(L, "out of memory");
+  /* the Legendre maps live in the integrator layer: a midpoint integrator
+   * (any method would do) provides them */
+  if ((st = dm_integrator_new(&ls->sys, "midpoint", NULL, &ls->conv, &e)) != DM_OK)
+    dm_lua_fail(L, "system", st, &e);
+  dm_lsystem_push_params(L, -1);
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * names, parameters, vectors
+ * ======================================================================= */
+
+long dm_lua_system_coord(const dm_lsystem *ls, const char *name)
+{
+  for (size_t i = 0; i < ls->sys.n; i++)
+    if (ls->sys.coords != NULL && strcmp(ls->sys.coords[i], name) == 0)
+      return (long)i;
+  return -1;
+}
+
+long dm_lua_system_param(const dm_lsystem *ls, const char *name)
+{
+  for (size_t i = 0; i < ls->sys.npar; i++)
+    if (ls->sys.params != NULL && strcmp(ls->sys.params[i], name) == 0)
+      return (long)i;
+  return -1;
+}
+
+/* "a, b, c" of n names onto the stack. */
+const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n)
+{
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  for (size_t i = 0; i < n; i++) {
+    if (i > 0)
+      luaL_addstring(&b, ", ");
+    luaL_addstring(&b, names[i]);
+  }
+  if (n == 0)
+    luaL_addstring(&b, "none");
+  luaL_pushresult(&b);
+  return lua_tostring(L, -1);
+}
+
+long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg)
+{
+  const char *name = luaL_checkstring(L, arg);
+  long i = dm_lua_system_param(ls, name);
+  if (i < 0)
+    luaL_error(L, "no parameter '%s' in system '%s' (parameters: %s)", name, ls->sys.name,
+               dm_lsystem_names(L, ls->sys.params, ls->sys.npar));
+  return i;
+}
+
+long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg)
+{
+  const char *name = luaL_checkstring(L, arg);
+  long i = dm_lua_system_coord(ls, name);
+  if (i < 0)
+    luaL_error(L, "no coordinate '%s' in system '%s' (coordinates: %s)", name, ls->sys.name,
+               dm_lsystem_names(L, ls->sys.coords, ls->sys.n));
+  return i;
+}
+
+void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x)
+{
+  dm_err e;
+  ls->sys.par[i] = x;
+  ls->gen++;
+  if (ls->traced && dm_lagrangian_refresh(&ls->sys, &e) != DM_OK)
+    dm_lua_fail(L, "parameter", e.status, &e);
+}
+
+void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
+                           const char *what, double *out)
+{
+  size_t n = ls->n, k;
+  gsl_vector *v;
+  idx = lua_absindex(L, idx);
+  if ((v = dm_tovec(L, idx)) != NULL) {
+    if (v->size != n)
+      luaL_error(L, "%s: vector of length %d expected, got length %d", what, (int)n,
+                 (int)v->size);
+    for (k = 0; k < n; k++)
+      out[k] = gsl_vector_get(v, k);
+    return;
+  }
+  if (lua_type(L, idx) != LUA_TTABLE)
+    luaL_error(L, "%s: vec or table of %d numbers expected, got %s", what, (int)n,
+               luaL_typename(L, idx));
+  k = lua_rawlen(L, idx);
+  if (k > 0) {
+    if (k != n)
+      luaL_error(L, "%s: vector of length %d expected, got length %d", what, (int)n, (int)k);
+    for (k = 0; k < n; k++) {
+      int isnum;
+      lua_rawgeti(L, idx, (lua_Integer)k + 1);
+      out[k] = lua_tonumberx(L, -1, &isnum);
+      if (!isnum)
+        luaL_error(L, "%s: number expected at index %d, got %s", what, (int)k + 1,
+                   luaL_typename(L, -1));
+      lua_pop(L, 1);
+    }
+    return;
+  }
+  /* keyed by coordinate names */
+  lua_pushnil(L);
+  while (lua_next(L, idx) != 0) {
+    if (lua_type(L, -2) != LUA_TSTRING || dm_lua_system_coord(ls, lua_tostring(L, -2)) < 0) {
+      const char *key = luaL_tolstring(L, -2, NULL);
+      const char *known = dm_lsystem_names(L, ls->sys.coords, n);
+      luaL_error(L, "%s: unknown coordinate %s (coordinates: %s)", what, key, known);
+    }
+    lua_pop(L, 1);
+  }
+  for (k = 0; k < n; k++) {
+    int isnum;
+    lua_getfield(L, idx, ls->sys.coords[k]);
+    out[k] = lua_tonumberx(L, -1, &isnum);
+    if (!isnum)
+      luaL_error(L, "%s: %s for coordinate '%s'", what,
+                 lua_isnil(L, -1) ? "no value" : "number expected", ls->sys.coords[k]);
+    lua_pop(L, 1);
+  }
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * dm.system{...}
+ * ======================================================================= */
+
+/* Names used as symbols and column names: identifiers. */
+static int is_ident(const char *s)
+{
+  if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || *s == '_'))
+    return 0;
+  for (s++; *s; s++)
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || *s == '_' ||
+          (*s >= '0' && *s <= '9')))
+      return 0;
+  return 1;
+}
+
+/* coords = {"r", "theta", ...}: pushes a userdata array of names (kept
+ * alive by the table at t). */
+static const char **read_coords(lua_State *L, int t, size_t *n)
+{
+  const char **names;
+  if (lua_getfield(L, t, "coords") != LUA_TTABLE || (*n = lua_rawlen(L, -1)) == 0)
+    luaL_error(L, "dm.system: field 'coords' must be a non-empty list of coordinate names, got %s",
+               luaL_typename(L, -1));
+  int c = lua_gettop(L);
+  names = lua_newuserdatauv(L, *n * sizeof *names, 0);
+  for (size_t i = 0; i < *n; i++) {
+    if (lua_rawgeti(L, c, (lua_Integer)i + 1) != LUA_TSTRING || !is_ident(lua_tostring(L, -1)))
+      luaL_error(L, "dm.system: coordinate %d must be a name (letters, digits, _), got %s",
+                 (int)i + 1, luaL_tolstring(L, -1, NULL));
+    names[i] = lua_tostring(L, -1);
+    lua_pop(L, 1);
+    for (size_t j = 0; j < i; j++)
+      if (strcmp(names[j], names[i]) == 0)
+        luaL_error(L, "dm.system: coordinate '%s' is listed twice", names[i]);
+  }
+  return names;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+  return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* params = {name = value, ...} (sorted by name) or {{name, value}, ...}
+ * (this order).  Pushes two userdata arrays (names, values); names are
+ * anchored in the params table. */
+static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
+{
+  size_t n = 0, k = 0;
+  int type = lua_getfield(L, t, "params"), p = lua_gettop(L), pairs;
+  if (type != LUA_TNIL && type != LUA_TTABLE)
+    luaL_error(L, "dm.system: field 'params' must be a table {name = value} or "
+               "{{name, value}, ...}, got %s", luaL_typename(L, p));
+  pairs = type == LUA_TTABLE && lua_rawlen(L, p) > 0;
+  if (type == LUA_TTABLE) {
+    lua_pushnil(L);
+    while (lua_next(L, p) != 0) {
+      n++;
+      lua_pop(L, 1);
+    }
+  }
+  const char **names = lua_newuserdatauv(L, (n + 1) * sizeof *names, 0);
+  double *vals = lua_newuserdatauv(L, (n + 1) * sizeof *vals, 0);
+  for (size_t i = 0; pairs && i < n; i++) {
+    if (lua_rawgeti(L, p, (lua_Integer)i + 1) != LUA_TTABLE ||
+        lua_rawgeti(L, -1, 1) != LUA_TSTRING || lua_rawgeti(L, -2, 2) != LUA_TNUMBER)
+      luaL_error(L, "dm.system: params entry %d must be {name, number}", (int)i + 1);
+    names[k] = lua_tostring(L, -2);
+    vals[k++] = lua_tonumber(L, -1);
+    lua_pop(L, 3);
+  }
+  if (pairs && k != n)
+    luaL_error(L, "dm.system: params must be either {name = value} or a list of {name, value}");
+  if (!pairs && type == LUA_TTABLE) {
+    lua_pushnil(L);
+    while (lua_next(L, p) != 0) {
+      if (lua_type(L, -2) != LUA_TSTRING || lua_type(L, -1) != LUA_TNUMBER)
+        luaL_error(L, "dm.system: params must map names to numbers (got %s = %s)",
+                   luaL_typename(L, -2), luaL_typename(L, -1));
+      names[k++] = lua_tostring(L, -2);
+      lua_pop(L, 1);
+    }
+    qsort(names, n, sizeof *names, cmp_str);
+    for (k = 0; k < n; k++) {
+      lua_getfield(L, p, names[k]);
+      vals[k] = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+    }
+  }
+  for (k = 0; k < n; k++) {
+    if (!is_ident(names[k]))
+      luaL_error(L, "dm.system: parameter name '%s' must be letters, digits and _", names[k]);
+    for (size_t j = 0; j < k; j++)
+      if (strcmp(names[j], names[k]) == 0)
+        luaL_error(L, "dm.system: parameter '%s' is listed twice", names[k]);
+  }
+  *pn = names;
+  *pv = vals;
+  return n;
+}
+
+/* Trace field `field` (a function) of the table t with the symbolic
+ * vectors at args[0..nargs); convert its result to nodes: one expression
+ * when scalar, else want of them (0: any number >= 1) as a list (or a bare
+ * expression when want == 1).  Returns the count; nodes malloc'ed into
+ * *out. */
+static size_t trace_field(lua_State *L, int t, const char *field, const int *args, int nargs,
+                          int scalar, size_t want, dm_expr **out, const char *sysname)
+{
+  char what[160];
+  size_t cnt, rows, cols;
+  if (lua_getfield(L, t, field) != LUA_TFUNCTION)
+    luaL_error(L, "dm.system: field '%s' must be a function, got %s", field, luaL_typename(L, -1));
+  snprintf(what, sizeof what, "%s of system '%s'", field, sysname);
+  for (int i = 0; i < nargs; i++)
+    lua_pushvalue(L, args[i]);
+  dm_lua_trace(L, what, nargs);
+  if (lua_isnil(L, -1))
+    luaL_error(L, "dm.system: %s returned nothing (return %s)", what,
+               scalar ? "an expression" : "a list of expressions");
+  cnt = dm_lua_toexprs(L, -1, what, NULL, 0, &rows, &cols);
+  if (scalar && cols != 0)
+    luaL_error(L, "dm.system: %s must return one expression, got a list of %d", what, (int)cnt);
+  if (rows != 1 || (want > 0 && cnt != want))
+    luaL_error(L, "dm.system: %s must return a list of %d expressions (one per coordinate), "
+               "got %d value%s", what, (int)want, (int)cnt, cnt == 1 ? "" : "s");
+  if ((*out = malloc(cnt * sizeof **out)) == NULL)
+    luaL_error(L, "out of memory");
+  dm_lua_toexprs(L, -1, what, *out, cnt, NULL, NULL);
+  lua_pop(L, 1);
+  return cnt;
+}
+
+static void detect_cyclic(lua_State *L, dm_lsystem *ls)
+{
+  dm_expr_ctx *ctx = dm_lua_exprctx(L);
+  for (size_t i = 0; i < ls->n; i++) {
+    int dep = dm_expr_depends(ctx, ls->L, 1, &ls->q[i]);
+    for (size_t k = 0; !dep && ls->force && k < ls->n; k++)
+      dep = dm_expr_depends(ctx, ls->force[k], 1, &ls->q[i]);
+    for (size_t k = 0; !dep && k < ls->m; k++)
+      dep = dm_expr_depends(ctx, ls->constr[k], 1, &ls->q[i]);
+    ls->cyclic[i] = !dep;
+  }
+}
+
+static int native_mode(lua_State *L, int t)
+{
+  int mode = dm_lua_native_mode(L), type = lua_getfield(L, t, "native");
+  if (type == LUA_TBOOLEAN)
+    mode = lua_toboolean(L, -1) ? DM_NATIVE_ALWAYS : DM_NATIVE_NEVER;
+  else if (type == LUA_TSTRING)
+    mode = dm_native_mode_parse(lua_tostring(L, -1));
+  else if (type != LUA_TNIL)
+    mode = -1;
+  if (mode < 0)
+    luaL_error(L, "dm.system: native must be \"auto\", \"always\", \"never\" or a boolean");
+  lua_pop(L, 1);
+  return mode;
+}
+
+/* dm.system{name=, coords=, params=, L=, force=, constraints=, native=} */
+static int l_system(lua_State *L)
+{
+  dm_lagrangian_spec sp;
+  dm_lagrangian_stats st;
+  dm_err e;
+  const char **coords, **pnames;
+  double *pvals;
+  size_t n, npar, m = 0;
+  int args[3], s;
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_settop(L, 1);
+  const char *name = dm_optstringfield(L, 1, "name", "system");
+  dm_lsystem *ls = dm_lua_system_new(L);             /* 2 */
+  coords = read_coords(L, 1, &n);
+  npar = read_params(L, 1, &pnames, &pvals);
+  int mode = native_mode(L, 1);
+  lua_getfield(L, 1, "L");
+  if (!lua_isfunction(L, -1))
+    return luaL_error(L, "dm.system: field 'L' must be a function L(q, v, p) returning the "
+                      "Lagrangian, got %s", luaL_typename(L, -1));
+  lua_pop(L, 1);
+  dm_lua_pushsymvec(L, "q", n, coords, NULL, DM_EXPR_SYM);
+  args[0] = lua_gettop(L);
+  dm_lua_pushsymvec(L, "v", n, coords, "v_%s", DM_EXPR_SYM);
+  args[1] = lua_gettop(L);
+  dm_lua_pushsymvec(L, "p", npar, pnames, NULL, DM_EXPR_PARAM);
+  args[2] = lua_gettop(L);
+
+  ls->n = n;
+  ls->npar = npar;
+  ls->q = malloc(n * sizeof *ls->q);
+  ls->v = malloc(n * sizeof *ls->v);
+  ls->par = malloc((npar + 1) * sizeof *ls->par);
+  ls->cyclic = calloc(n, 1);
+  if (!ls->q || !ls->v || !ls->par || !ls->cyclic)
+    return luaL_error(L, "out of memory");
+  for (size_t i = 0; i < n; i++) {
+    lua_geti(L, args[0], (lua_Integer)i + 1);
+    ls->q[i] = dm_lua_toexpr(L, -1);
+    lua_geti(L, args[1], (lua_Integer)i + 1);
+    ls->v[i] = dm_lua_toexpr(L, -1);
+    lua_pop(L, 2);
+  }
+  for (size_t i = 0; i < npar; i++) {
+    lua_geti(L, args[2], (lua_Integer)i + 1);
+    ls->par[i] = dm_lua_toexpr(L, -1);
+    lua_pop(L, 1);
+  }
+  dm_expr *Lx;
+  trace_field(L, 1, "L", args, 3, 1, 1, &Lx, name);
+  ls->L = Lx[0];
+  free(Lx);
+  if (lua_getfield(L, 1, "force") != LUA_TNIL)
+    trace_field(L, 1, "force", args, 3, 0, n, &ls->force, name);
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "constraints") != LUA_TNIL) {
+    int cargs[2] = {args[0], args[2]};
+    m = trace_field(L, 1, "constraints", cargs, 2, 0, 0, &ls->constr, name);
+  }
+  lua_pop(L, 1);
+  ls->m = m;
+
+  memset(&sp, 0, sizeof sp);
+  sp.name = name;
+  sp.n = n;
+  sp.q = ls->q;
+  sp.v = ls->v;
+  sp.npar = npar;
+  sp.par = ls->par;
+  sp.par_values = pvals;
+  sp.coord_names = coords;
+  sp.param_names = pnames;
+  sp.L = ls->L;
+  sp.force = ls->force;
+  sp.m = m;
+  sp.constraints = ls->constr;
+  sp.native = mode;
+  if ((s = dm_lagrangian_compile(dm_lua_exprctx(L), &sp, &ls->sys, &e)) != DM_OK)
+    return dm_lua_fail(L, "dm.system", s, &e);
+  ls->traced = 1;
+  if (dm_lagrangian_stats_get(&ls->sys, &st) == DM_OK)
+    ls->native = st.native_all;
+  detect_cyclic(L, ls);
+  lua_pushvalue(L, 2);
+  dm_lua_system_finish(L, ls, NULL);
+  return 1;
+}
+
+/* }====================================================================== */
+
+static const dm_reg system_funcs[] = {
+  {"system", l_system,
+   "dm.system{name=, coords={...}, params={name=value} | {{name, value}, ...}, L=function(q, v, p), "
+   "force=function(q, v, p), constraints=function(q, p), native=} -> system",
+   "A mechanical system from a Lagrangian written in Lua (traced once with symbolic q, v, p: "
+   "q.r or q[1], v.r, p.J2), with an optional generalized force (a list of n components, "
+   "Lagrange-d'Alembert) and holonomic constraints g(q) = 0; every derivative is exact and "
+   "compiled (native per dm.config.native); params given as a map are ordered by name."},
+  {NULL, NULL, NULL, NULL}
+};
+
+void dm_open_system(lua_State *L)
+{
+  dm_lsystem_open_class(L);
+  dm_register(L, "dm.", system_funcs);
+}

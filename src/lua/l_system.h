@@ -1,0 +1,93 @@
+/* l_system.h -- the System userdata (dm.system, dm.builtin.*) for other
+ * bindings: integrators (l_integrator.c) and reduction read the compiled
+ * dm_system and, for traced systems, the expression nodes it came from.
+ *
+ * A System is a full userdata "dmech.system" holding a dm_lsystem.  Traced
+ * systems (dm.system{...}) keep the nodes of L, the coordinate and velocity
+ * symbols, the parameters, the force and constraint expressions in the Lua
+ * state's expression context (dm_lua_exprctx); built-in C systems
+ * (dm.builtin.*) have traced == 0 and no nodes: code that needs
+ * expressions (reduction) must refuse them with dm_lua_checktraced().
+ *
+ * Ownership: the userdata owns everything in the struct (released by its
+ * __gc).  Pointers taken from it (&ls->sys, names, node arrays) stay valid
+ * while the userdata is reachable: a binding that keeps one (an integrator)
+ * must anchor the System userdata, e.g. in its user value.  There is no
+ * __close: a system lives as long as anything refers to it.
+ *
+ * Parameters: ls->sys.par holds the current values (the compiled callbacks
+ * read them at every call).  Change them through dm_lua_system_setparam(),
+ * which refreshes derived data and bumps ls->gen; objects that cache
+ * anything computed from the parameters (integrators: the inverse mass
+ * matrix) compare gen and rebuild.
+ */
+#ifndef DM_L_SYSTEM_H
+#define DM_L_SYSTEM_H
+
+#include "dmlua.h"
+#include "core/expr.h"
+#include "core/system.h"
+#include "core/integrators/integrator.h"
+
+#define DM_SYSTEM_MT "dmech.system"
+
+typedef struct dm_lsystem {
+  dm_system sys;        /* the compiled system; sys.coords, sys.params are the names */
+  size_t n, npar, m;    /* = sys.n, sys.npar, sys.m */
+  int traced;           /* 1: dm.system (nodes below valid); 0: built-in C */
+  int native;           /* 1 when native code runs the Lagrangian */
+  unsigned long gen;    /* bumped by every parameter change */
+  /* expression nodes (traced systems only; else DM_EXPR_NONE / NULL) */
+  dm_expr L;
+  dm_expr *q, *v;       /* n coordinate and velocity symbols */
+  dm_expr *par;         /* npar parameter nodes, in sys.params order */
+  dm_expr *force;       /* n generalized-force components, or NULL */
+  dm_expr *constr;      /* m constraint expressions g(q) (0 = satisfied), or NULL */
+  unsigned char *cyclic;  /* n flags: L, force, constraints free of q_i */
+  /* private to l_system.c: conversions (Legendre maps) and scratch */
+  dm_integrator *conv;
+  double *buf;          /* 6n doubles */
+} dm_lsystem;
+
+/* The System at idx, or NULL. */
+dm_lsystem *dm_lua_tosystem(lua_State *L, int idx);
+/* The System at idx, or raise "bad argument #idx to 'f' (system expected,
+ * got X)". */
+dm_lsystem *dm_lua_checksystem(lua_State *L, int idx);
+/* Same, and raise "<what> needs a system defined by a Lagrangian
+ * (dm.system{...}); '<name>' is a built-in C system without expressions"
+ * for built-ins. */
+dm_lsystem *dm_lua_checktraced(lua_State *L, int idx, const char *what);
+
+/* Index of coordinate / parameter `name`, or -1. */
+long dm_lua_system_coord(const dm_lsystem *ls, const char *name);
+long dm_lua_system_param(const dm_lsystem *ls, const char *name);
+/* Set parameter i to x: refreshes the mass of traced systems, bumps gen. */
+void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x);
+
+/* Read n numbers for the system's coordinates from the value at idx: a vec,
+ * a list of numbers, or a table keyed by coordinate names ({r = 2, z = 0.3};
+ * missing names raise).  `what` names the value in messages ("state.q").
+ * Raises on a wrong type or length; writes out[0..n). */
+void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
+                           const char *what, double *out);
+
+/* Push a new System userdata in the empty state (metatable set, nothing
+ * allocated): for constructors of built-in systems, which then fill
+ * ls->sys and call dm_lua_system_finish(). */
+dm_lsystem *dm_lua_system_new(lua_State *L);
+/* Complete a System whose ls->sys is filled (allocate buffers, the
+ * conversion helper); raises on failure (the userdata then owns and frees
+ * whatever was filled).  cyclic: names of cyclic coordinates (NULL-ended
+ * list, may be NULL) for systems without expressions. */
+void dm_lua_system_finish(lua_State *L, dm_lsystem *ls, const char *const *cyclic);
+
+/* ---- shared by l_system.c and l_system_obj.c only ---- */
+int dm_lsystem_gc(lua_State *L);
+void dm_lsystem_open_class(lua_State *L);           /* metatables */
+void dm_lsystem_push_params(lua_State *L, int sys); /* sets the params proxy */
+const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n);
+long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg);
+long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg);
+
+#endif

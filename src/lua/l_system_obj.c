@@ -1,0 +1,410 @@
+/* l_system_obj.c -- the System object seen from Lua: conversion methods
+ * (energy, momentum, velocity, ...), parameters (sys:set, the sys.params
+ * proxy), fields (names, flags, the expressions L, dLdq, ... as printable
+ * values) and __tostring.  The constructor is in l_system.c. */
+#include <config.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "l_system.h"
+#include "l_expr.h"
+
+#define PARAMS_MT "dmech.params"
+
+/* The params proxy: a userdata pointing at its system (anchored in the
+ * proxy's user value).  Stored as the system's user value 1. */
+void dm_lsystem_push_params(lua_State *L, int sys)
+{
+  dm_lsystem **pp;
+  sys = lua_absindex(L, sys);
+  pp = lua_newuserdatauv(L, sizeof *pp, 1);
+  *pp = lua_touserdata(L, sys);
+  luaL_setmetatable(L, PARAMS_MT);
+  lua_pushvalue(L, sys);
+  lua_setiuservalue(L, -2, 1);
+  lua_setiuservalue(L, sys, 1);
+}
+
+/* {======================================================================
+ * methods: conversions
+ * ======================================================================= */
+
+static dm_lsystem *checksys(lua_State *L)
+{
+  return dm_lua_checksystem(L, 1);
+}
+
+/* Read (q, v) from arguments 2, 3 into ls->buf[0..2n). */
+static void read_qx(lua_State *L, dm_lsystem *ls, const char *fname, const char *xname)
+{
+  char what[64];
+  snprintf(what, sizeof what, "%s: q", fname);
+  dm_lua_system_readvec(L, ls, 2, what, ls->buf);
+  snprintf(what, sizeof what, "%s: %s", fname, xname);
+  dm_lua_system_readvec(L, ls, 3, what, ls->buf + ls->n);
+}
+
+static int s_momentum(lua_State *L)
+{
+  dm_lsystem *ls = checksys(L);
+  dm_err e;
+  int st;
+  read_qx(L, ls, "momentum", "v");
+  double *p = ls->buf + 2 * ls->n;
+  if ((st = dm_integrator_momentum(ls->conv, ls->buf, ls->buf + ls->n, p, &e)) != DM_OK)
+    return dm_lua_fail(L, "momentum", st, &e);
+  if (!lua_isnoneornil(L, 4)) {
+    lua_pushnumber(L, p[dm_lsystem_checkcoord(L, ls, 4)]);
+    return 1;
+  }
+  dm_pushvec_copy(L, p, ls->n);
+  return 1;
+}
+
+static int s_legendre(lua_State *L)
+{
+  lua_settop(L, 3);
+  return s_momentum(L);
+}
+
+static int s_velocity(lua_State *L)
+{
+  dm_lsystem *ls = checksys(L);
+  dm_err e;
+  int st;
+  read_qx(L, ls, "velocity", "p");
+  double *v = ls->buf + 2 * ls->n;
+  if ((st = dm_integrator_velocity(ls->conv, ls->buf, ls->buf + ls->n, v, 0, &e)) != DM_OK)
+    return dm_lua_fail(L, "velocity", st, &e);
+  dm_pushvec_copy(L, v, ls->n);
+  return 1;
+}
+
+static int s_energy(lua_State *L)
+{
+  dm_lsystem *ls = checksys(L);
+  dm_err e;
+  double E;
+  int st;
+  read_qx(L, ls, "energy", "v");
+  if ((st = dm_integrator_energy(ls->conv, ls->buf, ls->buf + ls->n, &E, &e)) != DM_OK)
+    return dm_lua_fail(L, "energy", st, &e);
+  lua_pushnumber(L, E);
+  return 1;
+}
+
+static int s_lagrangian(lua_State *L)
+{
+  dm_lsystem *ls = checksys(L);
+  dm_lag_out o;
+  void *work;
+  int st;
+  read_qx(L, ls, "lagrangian", "v");
+  work = lua_newuserdatauv(L, ls->sys.work_size + 8, 0);
+  memset(&o, 0, sizeof o);
+  o.Lq = ls->buf + 2 * ls->n;
+  o.Lv = ls->buf + 3 * ls->n;
+  st = ls->sys.lagrangian(ls->sys.data, ls->buf, ls->buf + ls->n, ls->sys.par, DM_LAG_L, &o, work);
+  if (st < 0)
+    return luaL_error(L, "lagrangian: the Lagrangian of '%s' failed (status %d)", ls->sys.name, st);
+  lua_pushnumber(L, st == 0 ? o.L : (double)NAN);
+  return 1;
+}
+
+/* Validate every entry of {name = value} before changing anything. */
+static int s_set(lua_State *L)
+{
+  dm_lsystem *ls = checksys(L);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    dm_lsystem_checkparam(L, ls, -2);
+    if (lua_type(L, -1) != LUA_TNUMBER)
+      return luaL_error(L, "set: parameter '%s' needs a number, got %s", lua_tostring(L, -2),
+                        luaL_typename(L, -1));
+    lua_pop(L, 1);
+  }
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    dm_lua_system_setparam(L, ls, (size_t)dm_lua_system_param(ls, lua_tostring(L, -2)),
+                           lua_tonumber(L, -1));
+    lua_pop(L, 1);
+  }
+  lua_settop(L, 1);
+  return 1;
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * fields: names, flags, expressions
+ * ======================================================================= */
+
+static void push_strings(lua_State *L, const char *const *s, size_t n, const unsigned char *sel)
+{
+  lua_Integer k = 0;
+  lua_createtable(L, (int)n, 0);
+  for (size_t i = 0; i < n; i++)
+    if (sel == NULL || sel[i]) {
+      lua_pushstring(L, s[i]);
+      lua_rawseti(L, -2, ++k);
+    }
+}
+
+static void push_exprs(lua_State *L, const dm_expr *x, size_t n)
+{
+  lua_createtable(L, (int)n, 0);
+  for (size_t i = 0; i < n; i++) {
+    dm_lua_pushexpr(L, x[i]);
+    lua_rawseti(L, -2, (lua_Integer)i + 1);
+  }
+}
+
+/* Derivatives of L: kind 'q' / 'v' gradient, "vv", "vq", "qq" matrices. */
+static void push_derivative(lua_State *L, dm_lsystem *ls, const char *kind)
+{
+  dm_expr_ctx *ctx = dm_lua_exprctx(L);
+  size_t n = ls->n;
+  dm_expr *g = lua_newuserdatauv(L, (n + n * n) * sizeof *g, 0);
+  dm_expr *H = g + n;
+  const dm_expr *a = kind[0] == 'q' ? ls->q : ls->v;
+  const dm_expr *b = kind[1] == 'q' ? ls->q : ls->v;
+  if (dm_expr_grad(ctx, ls->L, n, a, g, NULL) != DM_OK)
+    dm_lua_ctx_raise(L, ctx);
+  if (kind[1] == '\0') {
+    push_exprs(L, g, n);
+    return;
+  }
+  if (dm_expr_jacobian(ctx, n, g, n, b, H, NULL) != DM_OK)
+    dm_lua_ctx_raise(L, ctx);
+  lua_createtable(L, (int)n, 0);
+  for (size_t i = 0; i < n; i++) {
+    push_exprs(L, H + i * n, n);
+    lua_rawseti(L, -2, (lua_Integer)i + 1);
+  }
+}
+
+static int expr_field(lua_State *L, dm_lsystem *ls, const char *k)
+{
+  static const struct { const char *name, *kind; } der[] = {
+    {"dLdq", "q"}, {"dLdv", "v"}, {"d2Ldv2", "vv"}, {"d2Ldvdq", "vq"}, {"d2Ldq2", "qq"}
+  };
+  size_t i;
+  int known = strcmp(k, "L") == 0 || strcmp(k, "force") == 0 || strcmp(k, "constraints") == 0;
+  for (i = 0; i < sizeof der / sizeof der[0]; i++)
+    known |= strcmp(k, der[i].name) == 0;
+  if (!known)
+    return 0;
+  if (!ls->traced)
+    return luaL_error(L, "system.%s: '%s' is a built-in C system without expressions", k,
+                      ls->sys.name);
+  if (strcmp(k, "L") == 0) {
+    dm_lua_pushexpr(L, ls->L);
+  } else if (strcmp(k, "force") == 0) {
+    if (ls->force)
+      push_exprs(L, ls->force, ls->n);
+    else
+      lua_pushnil(L);
+  } else if (strcmp(k, "constraints") == 0) {
+    if (ls->m)
+      push_exprs(L, ls->constr, ls->m);
+    else
+      lua_pushnil(L);
+  } else {
+    for (i = 0; strcmp(k, der[i].name) != 0; i++)
+      ;
+    push_derivative(L, ls, der[i].kind);
+  }
+  return 1;
+}
+
+static int system_index(lua_State *L)
+{
+  dm_lsystem *ls = luaL_checkudata(L, 1, DM_SYSTEM_MT);
+  const char *k;
+  if (lua_getfield(L, lua_upvalueindex(1), luaL_checkstring(L, 2)) != LUA_TNIL)
+    return 1;
+  k = lua_tostring(L, 2);
+  if (ls->sys.lagrangian == NULL)
+    return luaL_error(L, "the system is not initialised");
+  if (strcmp(k, "name") == 0)
+    lua_pushstring(L, ls->sys.name);
+  else if (strcmp(k, "n") == 0)
+    lua_pushinteger(L, (lua_Integer)ls->n);
+  else if (strcmp(k, "m") == 0)
+    lua_pushinteger(L, (lua_Integer)ls->m);
+  else if (strcmp(k, "coords") == 0)
+    push_strings(L, ls->sys.coords, ls->n, NULL);
+  else if (strcmp(k, "cyclic") == 0)
+    push_strings(L, ls->sys.coords, ls->n, ls->cyclic);
+  else if (strcmp(k, "params") == 0)
+    lua_getiuservalue(L, 1, 1);
+  else if (strcmp(k, "traced") == 0)
+    lua_pushboolean(L, ls->traced);
+  else if (strcmp(k, "native") == 0)
+    lua_pushboolean(L, ls->native);
+  else if (strcmp(k, "separable") == 0)
+    lua_pushboolean(L, (ls->sys.flags & DM_SYS_SEPARABLE) != 0);
+  else if (strcmp(k, "mechanical") == 0)
+    lua_pushboolean(L, (ls->sys.flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0);
+  else if (strcmp(k, "forced") == 0)
+    lua_pushboolean(L, ls->sys.force != NULL);
+  else if (!expr_field(L, ls, k))
+    return luaL_error(L, "system has no field or method '%s' (fields: name, n, m, coords, "
+                      "params, cyclic, traced, native, separable, mechanical, forced, L, "
+                      "dLdq, dLdv, d2Ldv2, d2Ldvdq, d2Ldq2, force, constraints)", k);
+  return 1;
+}
+
+static int system_tostring(lua_State *L)
+{
+  dm_lsystem *ls = luaL_checkudata(L, 1, DM_SYSTEM_MT);
+  luaL_Buffer b;
+  char num[32];
+  if (ls->sys.lagrangian == NULL) {
+    lua_pushliteral(L, "<system (empty)>");
+    return 1;
+  }
+  luaL_buffinit(L, &b);
+  lua_pushfstring(L, "<system '%s': %d coords (", ls->sys.name, (int)ls->n);
+  luaL_addvalue(&b);
+  for (size_t i = 0; i < ls->n; i++) {
+    luaL_addstring(&b, ls->sys.coords[i]);
+    luaL_addstring(&b, i + 1 < ls->n ? ", " : ")");
+  }
+  for (size_t i = 0; i < ls->npar; i++) {
+    luaL_addstring(&b, i == 0 ? ", " : " ");
+    luaL_addstring(&b, ls->sys.params[i]);
+    luaL_addchar(&b, '=');
+    dm_fmtnum(num, sizeof num, ls->sys.par[i]);
+    luaL_addstring(&b, num);
+  }
+  if (ls->m) {
+    lua_pushfstring(L, ", %d constraint%s", (int)ls->m, ls->m == 1 ? "" : "s");
+    luaL_addvalue(&b);
+  }
+  if (ls->sys.force)
+    luaL_addstring(&b, ", forced");
+  luaL_addstring(&b, ls->traced ? (ls->native ? "; traced, native" : "; traced, tape")
+                                : "; built-in C");
+  if (ls->sys.flags & DM_SYS_SEPARABLE)
+    luaL_addstring(&b, ", separable");
+  else if (ls->sys.flags & DM_SYS_MECHANICAL)
+    luaL_addstring(&b, ", mechanical");
+  luaL_addchar(&b, '>');
+  luaL_pushresult(&b);
+  return 1;
+}
+
+/* }====================================================================== */
+
+/* {======================================================================
+ * the params proxy
+ * ======================================================================= */
+
+static dm_lsystem *proxy_sys(lua_State *L)
+{
+  return *(dm_lsystem **)luaL_checkudata(L, 1, PARAMS_MT);
+}
+
+static int params_index(lua_State *L)
+{
+  dm_lsystem *ls = proxy_sys(L);
+  lua_pushnumber(L, ls->sys.par[dm_lsystem_checkparam(L, ls, 2)]);
+  return 1;
+}
+
+static int params_newindex(lua_State *L)
+{
+  dm_lsystem *ls = proxy_sys(L);
+  long i = dm_lsystem_checkparam(L, ls, 2);
+  if (lua_type(L, 3) != LUA_TNUMBER)
+    return luaL_error(L, "parameter '%s' needs a number, got %s", ls->sys.params[i],
+                      luaL_typename(L, 3));
+  dm_lua_system_setparam(L, ls, (size_t)i, lua_tonumber(L, 3));
+  return 0;
+}
+
+static int params_next(lua_State *L)
+{
+  dm_lsystem *ls = proxy_sys(L);
+  long i = lua_isnil(L, 2) ? 0 : dm_lua_system_param(ls, luaL_checkstring(L, 2)) + 1;
+  if (i < 0 || (size_t)i >= ls->npar)
+    return 0;
+  lua_pushstring(L, ls->sys.params[i]);
+  lua_pushnumber(L, ls->sys.par[i]);
+  return 2;
+}
+
+static int params_pairs(lua_State *L)
+{
+  proxy_sys(L);
+  lua_pushcfunction(L, params_next);
+  lua_pushvalue(L, 1);
+  lua_pushnil(L);
+  return 3;
+}
+
+static int params_len(lua_State *L)
+{
+  lua_pushinteger(L, (lua_Integer)proxy_sys(L)->npar);
+  return 1;
+}
+
+static int params_tostring(lua_State *L)
+{
+  dm_lsystem *ls = proxy_sys(L);
+  luaL_Buffer b;
+  char num[32];
+  luaL_buffinit(L, &b);
+  luaL_addchar(&b, '{');
+  for (size_t i = 0; i < ls->npar; i++) {
+    luaL_addstring(&b, i ? ", " : "");
+    luaL_addstring(&b, ls->sys.params[i]);
+    luaL_addstring(&b, " = ");
+    dm_fmtnum(num, sizeof num, ls->sys.par[i]);
+    luaL_addstring(&b, num);
+  }
+  luaL_addchar(&b, '}');
+  luaL_pushresult(&b);
+  return 1;
+}
+
+/* }====================================================================== */
+
+static const luaL_Reg params_meta[] = {
+  {"__index", params_index}, {"__newindex", params_newindex}, {"__pairs", params_pairs},
+  {"__len", params_len}, {"__tostring", params_tostring}, {NULL, NULL}
+};
+
+static const luaL_Reg system_meta[] = {
+  {"__gc", dm_lsystem_gc}, {"__tostring", system_tostring}, {NULL, NULL}
+};
+
+static const dm_reg system_methods[] = {
+  {"energy", s_energy, "sys:energy(q, v) -> number",
+   "The energy E = p.v - L at (q, v), p = dL/dv."},
+  {"momentum", s_momentum, "sys:momentum(q, v[, coord]) -> vec | number",
+   "The conjugate momenta p = dL/dv at (q, v), or the component of one coordinate."},
+  {"legendre", s_legendre, "sys:legendre(q, v) -> p",
+   "The Legendre transform p = dL/dv (q, v) (the momenta of a state given by velocities)."},
+  {"velocity", s_velocity, "sys:velocity(q, p) -> v",
+   "The velocity with dL/dv (q, v) = p, by Newton (one step for mechanical L); raises when d2L/dv2 is singular."},
+  {"lagrangian", s_lagrangian, "sys:lagrangian(q, v) -> number",
+   "The value of the Lagrangian at (q, v)."},
+  {"set", s_set, "sys:set{name = value, ...} -> sys",
+   "Change parameters (all checked first); compiled code reads them at once, nothing is recompiled."},
+  {NULL, NULL, NULL, NULL}
+};
+
+void dm_lsystem_open_class(lua_State *L)
+{
+  dm_newclass(L, PARAMS_MT, "params", NULL, params_meta);
+  lua_pop(L, 1);
+  dm_newclass(L, DM_SYSTEM_MT, "system", system_methods, system_meta);
+  lua_getfield(L, -1, "__methods");
+  lua_pushcclosure(L, system_index, 1);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+}
