@@ -20,6 +20,8 @@ typedef struct prog {
   dm_native_fn fn;
   dm_native_scatter_fn scatter;   /* native, writing the caller's arrays */
   size_t nout, nregs;
+  size_t nmap;                    /* tape path: output destinations */
+  struct dest { uint32_t reg, arr, elem; } *map;
 } prog;
 
 typedef struct lag_data {
@@ -36,6 +38,7 @@ typedef struct lag_data {
 
 static void prog_free(prog *p)
 {
+  free(p->map);
   dm_native_free(p->nat);
   dm_tape_free(p->tape);
   memset(p, 0, sizeof *p);
@@ -80,6 +83,27 @@ static inline double *prog_run(const prog *p, double *w, const double *par)
   return o;
 }
 
+/* The tape path of a callback: run on the inputs already in w, test the
+ * outputs in their registers, scatter them to the arrays of out[] whose
+ * bit is in mask.  Returns 1 (nothing written) for NaN or Inf. */
+static int tape_scatter(const prog *p, double *w, const double *par,
+                        double *const *out, unsigned mask)
+{
+  dm_tape_run(p->tape, w, par, w);
+  const uint32_t *reg = dm_tape_outregs(p->tape);
+  int bad = 0;
+  for (size_t k = 0; k < p->nout; k++)
+    bad |= !(fabs(w[reg[k]]) <= DBL_MAX);
+  if (bad)
+    return 1;             /* outside the domain: retry with another step */
+  for (size_t j = 0; j < p->nmap; j++) {
+    const struct dest *dj = &p->map[j];
+    if (mask & (1u << dj->arr))
+      out[dj->arr][dj->elem] = w[dj->reg];
+  }
+  return 0;
+}
+
 static inline void copy(double *dst, const double *src, size_t k)
 {
   for (size_t i = 0; i < k; i++)
@@ -96,16 +120,6 @@ static int nonfinite(const double *x, size_t k)
   return bad;
 }
 
-/* Copy a packed upper triangle into a full symmetric n*n matrix. */
-static const double *unpack_sym(const double *o, size_t n, double *M)
-{
-  for (size_t i = 0; i < n; i++)
-    for (size_t j = i; j < n; j++) {
-      M[i * n + j] = M[j * n + i] = *o++;
-    }
-  return o;
-}
-
 /* {==================================================================
  * callbacks
  * =================================================================== */
@@ -117,35 +131,15 @@ static int lag_eval(void *data, const double *q, const double *v,
   const lag_data *d = data;
   const size_t n = d->n;
   const prog *p = (what & ~(unsigned)DM_LAG_GRAD) ? &d->all : &d->grad;
+  double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
     return p->scatter(in, par, o, what | DM_LAG_L);
   }
   double *w = work;
   copy(w, q, n);
   copy(w + n, v, n);
-  const double *o = prog_run(p, w, par);
-  if (nonfinite(o, p->nout))
-    return 1;               /* outside the domain: retry with another step */
-  out->L = o[0];
-  if (what & DM_LAG_Q)
-    copy(out->Lq, o + 1, n);
-  if (what & DM_LAG_V)
-    copy(out->Lv, o + 1 + n, n);
-  if (p == &d->all) {
-    const double *r = o + 1 + 2 * n;
-    size_t tri = n * (n + 1) / 2;
-    if (what & DM_LAG_VV)
-      unpack_sym(r, n, out->Lvv);
-    r += tri;
-    if (what & DM_LAG_VQ)
-      copy(out->Lvq, r, n * n);
-    r += n * n;
-    if (what & DM_LAG_QQ)
-      unpack_sym(r, n, out->Lqq);
-  }
-  return 0;
+  return tape_scatter(p, w, par, o, what | DM_LAG_L);
 }
 
 static int force_eval(void *data, const double *q, const double *v,
@@ -155,24 +149,15 @@ static int force_eval(void *data, const double *q, const double *v,
   const lag_data *d = data;
   const size_t n = d->n;
   const prog *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  double *o[3] = { F, Fq, Fv };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    double *o[3] = { F, Fq, Fv };
     return p->scatter(in, par, o, what);
   }
   double *w = work;
   copy(w, q, n);
   copy(w + n, v, n);
-  const double *o = prog_run(p, w, par);
-  if (nonfinite(o, p->nout))
-    return 1;
-  if (what & DM_FORCE_F)
-    copy(F, o, n);
-  if (what & DM_FORCE_Q)
-    copy(Fq, o + n, n * n);
-  if (what & DM_FORCE_V)
-    copy(Fv, o + n + n * n, n * n);
-  return 0;
+  return tape_scatter(p, w, par, o, what);
 }
 
 static int constr_eval(void *data, const double *q, const double *par,
@@ -180,28 +165,15 @@ static int constr_eval(void *data, const double *q, const double *par,
                        void *work)
 {
   const lag_data *d = data;
-  const size_t n = d->n, m = d->m;
   const prog *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
+  double *o[3] = { g, G, H };
   if (p->scatter != NULL) {
     const double *in[1] = { q };
-    double *o[3] = { g, G, H };
     return p->scatter(in, par, o, what);
   }
   double *w = work;
-  copy(w, q, n);
-  const double *o = prog_run(p, w, par);
-  if (nonfinite(o, p->nout))
-    return 1;
-  if (what & DM_CONSTR_G)
-    copy(g, o, m);
-  if (what & DM_CONSTR_DG)
-    copy(G, o + m, m * n);
-  if (what & DM_CONSTR_D2G) {
-    const double *r = o + m + m * n;
-    for (size_t a = 0; a < m; a++)
-      r = unpack_sym(r, n, H + a * n * n);
-  }
-  return 0;
+  copy(w, q, d->n);
+  return tape_scatter(p, w, par, o, what);
 }
 
 /* {==================================================================
@@ -278,15 +250,23 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
     return s;
   p->nout = nout;
   p->nregs = dm_tape_work_size(p->tape);
-  if (sp->native == DM_NATIVE_NEVER)
-    return DM_OK;
   size_t nmap = 0, n = sp->n;
   dm_native_map *inmap = malloc((nin + 1) * sizeof *inmap);
   dm_native_map *outmap = make_outmap(blk, nblk, nout, &nmap);
-  if (inmap == NULL || outmap == NULL) {
+  p->map = malloc((nmap + 1) * sizeof *p->map);
+  if (inmap == NULL || outmap == NULL || p->map == NULL) {
     free(inmap);
     free(outmap);
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  }
+  const uint32_t *reg = dm_tape_outregs(p->tape);
+  for (size_t j = 0; j < nmap; j++)
+    p->map[j] = (struct dest){ reg[outmap[j].k], outmap[j].arr, outmap[j].elem };
+  p->nmap = nmap;
+  if (sp->native == DM_NATIVE_NEVER) {
+    free(inmap);
+    free(outmap);
+    return DM_OK;
   }
   for (size_t i = 0; i < nin; i++)           /* q, then v */
     inmap[i] = (dm_native_map){ (uint32_t)i, (uint32_t)(i / n), (uint32_t)(i % n) };

@@ -74,6 +74,10 @@ void dm_tape_free(dm_tape *t);
 void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
                   double *out, double *work);
 size_t dm_tape_work_size(const dm_tape *t);
+/* The same without collecting the outputs: output k stays in
+ * work[dm_tape_outregs(t)[k]] (for callers that scatter them). */
+void dm_tape_run(const dm_tape *t, const double *in, const double *par,
+                 double *work);
 
 /* Evaluate at npts points: point k reads in + k*in_stride and writes
  * out + k*out_stride (strides in doubles); par is shared.  Vectorised over

@@ -82,6 +82,14 @@ static void load(const dm_tape *t, const double *in, const double *par,
 void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
                   double *out, double *w)
 {
+  dm_tape_run(t, in, par, w);
+  for (size_t k = 0; k < t->nout; k++)
+    out[k] = w[t->outreg[k]];
+}
+
+void dm_tape_run(const dm_tape *t, const double *in, const double *par,
+                 double *w)
+{
   load(t, in, par, w);
   const dm_tape_ins *ip = t->code, *end = ip + t->ninstr;
   if (ip < end) {
@@ -113,8 +121,6 @@ done:;
     }
 #endif
   }
-  for (size_t k = 0; k < t->nout; k++)
-    out[k] = w[t->outreg[k]];
 }
 
 #undef B
