@@ -417,7 +417,7 @@ int main(void)
   const char *tt = getenv("DMECH_TESTTMP");
   if (tt && *tt) {               /* native objects only under the build tree */
     static char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s/native-tmp", tt);
+    snprintf(tmp, sizeof tmp, "%s/native-tmp-lagrangian", tt);
     mkdir(tmp, 0700);            /* may exist already */
     setenv("TMPDIR", tmp, 1);
   } else {

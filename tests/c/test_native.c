@@ -252,7 +252,8 @@ int main(void)
     static char d[] = "/tmp/dmech-test-native-XXXXXX";
     tt = mkdtemp(d);
   }
-  snprintf(tmpdir, sizeof tmpdir, "%s/native-tmp", tt);
+  /* a directory of its own: test programs run in parallel */
+  snprintf(tmpdir, sizeof tmpdir, "%s/native-tmp-native", tt);
   mkdir(tmpdir, 0700);
   setenv("TMPDIR", tmpdir, 1);
   const char *xc = getenv("XDG_CACHE_HOME");
