@@ -116,4 +116,27 @@ int dm_gld_solve(dm_gld *g, double h, const double *q0, const double *q1, double
                  double *d11, int warm, dm_err *e);
 int dm_gld_iters(const dm_gld *g);
 
+/* RSPRK engine (rsprk.c): the reduced symplectic PRK step of thesis eq.
+ * 2.5.14 on T*S for any PRK tableau, constraints with Lobatto-type
+ * tableaus (multipliers at every stage) or one stage. */
+typedef struct dm_rsprk dm_rsprk;
+int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, int simplified,
+                   dm_rsprk **out, dm_err *e);
+void dm_rsprk_free(dm_rsprk *P);
+void dm_rsprk_reset(dm_rsprk *P);
+/* (x0, s0) -> (x1, s1); dtheta (r, may be NULL) = h sum_j b_j Thetadot_j. */
+int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, double *x1,
+                  double *s1, double *dtheta, dm_integ_stats *st, dm_err *e);
+/* D(x1, s1)/D(x0, s0), 2s x 2s row-major (unconstrained only). */
+int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0, double *DPhi,
+                      dm_integ_stats *st, dm_err *e);
+const dm_tableau *dm_rsprk_tableau(const dm_rsprk *P);
+
+/* Singular-inertia test shared by the reduced integrators: *ref is set from
+ * x on the first call (ref <= 0); returns DM_ESINGULAR with a message when
+ * lambda_min(I(x)) <= sing_tol * ref or I(x) is not finite.  work: at least
+ * r*r + red->nwork doubles. */
+int dm_routh_check_inertia(const dm_routh *red, const double *x, double *ref, double *work,
+                           const char *where, dm_err *e);
+
 #endif

@@ -8,6 +8,7 @@
 
 extern const dm_integrator_type dm_integ_midpoint, dm_integ_gauss, dm_integ_trapezoid,
   dm_integ_lobatto, dm_integ_prk, dm_integ_composition, dm_integ_rk4, dm_integ_gsl;
+extern const dm_integrator_type dm_integ_routh;   /* src/reduce/routh_integ.c */
 
 static const dm_integrator_type *const registry[] = {
   &dm_integ_midpoint,
@@ -18,6 +19,7 @@ static const dm_integrator_type *const registry[] = {
   &dm_integ_composition,
   &dm_integ_rk4,
   &dm_integ_gsl,
+  &dm_integ_routh,
   NULL
 };
 

@@ -1,0 +1,662 @@
+/* rsprk.c -- the reduced symplectic partitioned Runge-Kutta method (thesis
+ * §2.5, eq. 2.5.14; spec routh.md §5) on T*S with state (x, s),
+ * s = dR/dxdot, implemented directly from its equations:
+ *   X_i = x0 + h sum_j a_ij Xd_j
+ *   S_i = s0 + h sum_j at_ij Sd_j + [h sum_j at_ij K_j Xd_j - (muA(X_i) - muA(x0))]
+ *   S_i = dR/dxdot (X_i, Xd_i),   Sd_j = dR/dx (X_j, Xd_j) - i_{Xd_j} beta(X_j) + Fhat_j
+ *   x1 = x0 + h sum_j b_j Xd_j
+ *   s1 = s0 + h sum_j b_j Sd_j + [h sum_j b_j K_j Xd_j - (muA(x1) - muA(x0))]
+ * with K = d(mu^T A)/dx, (K Xd)_i = (mu dA/dx Xd)_i and (i_v beta)_c =
+ * sum_d v_d B_dc, each evaluated from its own compiled program (not through
+ * the classical Routhian: the momentum-shift equivalence is a test).
+ * Unknowns are the stage velocities; residual r_i = dR/dxdot(X_i, Xd_i) - S_i.
+ * Newton uses the exact Jacobian
+ *   dr_i/dXd_k = d_ik Rvv_i + h a_ik (Rvx_i + K_i) - h at_ik E_k - h^2 sum_j at_ij a_jk D_j,
+ *   E_k = Rxv_k - B_k^T + Fv_k + K_k,  D_j = Rxx_j - d(i beta)/dx_j + Fx_j + d(K Xd)/dx_j,
+ * with the engine's stopping rules (prk_engine.c: scaled update <= tol, or
+ * round-off stall once below 1e-10; simplified Newton reusing the factored
+ * exact Jacobian while updates contract tenfold).  The group increment of
+ * the step (Hamiltonian-side reconstruction) is h sum_j b_j Thetadot_j,
+ * Thetadot_j = I(X_j)^{-1} mu - A(X_j) Xd_j.  The step Jacobian comes from
+ * the implicit function theorem on the converged stage equations. */
+#include <config.h>
+#include "rsprk_impl.h"
+#include "core/interrupt.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NEWTON_ACCEPT 1e-10
+
+const dm_tableau *dm_rsprk_tableau(const dm_rsprk *P)
+{
+  return P->tab;
+}
+
+static void kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
+{
+  size_t i;
+  for (i = 0; i < n; i++) {
+    double y = dx[i] - carry[i];
+    double t = x0[i] + y;
+    carry[i] = (t - x0[i]) - y;
+    out[i] = t;
+  }
+}
+
+int dm_routh_check_inertia(const dm_routh *red, const double *x, double *ref, double *work,
+                           const char *where, dm_err *e)
+{
+  size_t r = red->r, i;
+  double lmin, lmax;
+  char bx[200];
+  dm_rprog_run(&red->inertia, x, red->par, work, work + r * r);
+  for (i = 0; i < r * r; i++)
+    if (!isfinite(work[i]))
+      return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) is not finite at %s x = %s",
+                        where, dm_rfmt_vec(bx, sizeof bx, x, red->s));
+  dm_routh_sym_eig(work, r, &lmin, &lmax);
+  if (!(*ref > 0.0)) {
+    if (!(lmin > 0.0))
+      return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) is singular at %s x = %s "
+                        "(smallest eigenvalue %.3g): the symmetry group does not act freely there",
+                        where, dm_rfmt_vec(bx, sizeof bx, x, red->s), lmin);
+    *ref = lmax;
+    return DM_OK;
+  }
+  if (!(lmin > red->sing_tol * *ref))
+    return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) became singular at %s x = %s "
+                      "(smallest eigenvalue %.3g <= %.3g x its initial size %.3g): the symmetry "
+                      "group does not act freely there (e.g. r -> 0) and the reduced equations "
+                      "break down", where, dm_rfmt_vec(bx, sizeof bx, x, red->s), lmin,
+                      red->sing_tol, *ref);
+  return DM_OK;
+}
+
+/* {==== allocation ======================================================= */
+
+void dm_rsprk_free(dm_rsprk *P)
+{
+  if (P == NULL)
+    return;
+  free(P->Jm);
+  free(P->work);
+  dm_rlu_free(&P->lu);
+  dm_rlu_free(&P->lu_small);
+  dm_tableau_free(P->tab);
+  free(P);
+}
+
+void dm_rsprk_reset(dm_rsprk *P)
+{
+  P->hist = 0;
+  P->E_ratio = NAN;
+  P->sing_ref = 0.0;
+  memset(P->cq, 0, P->d * sizeof(double));
+  memset(P->cp, 0, P->d * sizeof(double));
+}
+
+int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, int simplified,
+                   dm_rsprk **out, dm_err *e)
+{
+  dm_rsprk *P = calloc(1, sizeof *P);
+  size_t d = red->s, S = t->s, m = red->m, dd = d * d, Sd = S * d, tot, i, j, nsm, nout;
+  double *p;
+  int st;
+  *out = NULL;
+  if (P == NULL)
+    return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+  P->red = red;
+  P->sys = &red->rsys;
+  P->d = d;
+  P->S = S;
+  P->m = m;
+  P->r = red->r;
+  P->Sd = Sd;
+  P->dd = dd;
+  P->forced = red->rsys.force != NULL;
+  P->gyro = red->has_gyro;
+  P->tol = tol;
+  P->maxiter = maxiter;
+  P->simplified = simplified;
+  P->E_ratio = NAN;
+  if ((P->tab = dm_tableau_copy(t)) == NULL) {
+    free(P);
+    return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+  }
+  if (m > 0 && (st = dm_rsprk_constr_layout(P, e)) != DM_OK) {
+    dm_rsprk_free(P);
+    return st;
+  }
+  P->N = Sd + (m ? P->nK * m + m : 0);
+  nsm = d + m;
+  nout = red->gyro_j.nout > red->info.nout ? red->gyro_j.nout : red->info.nout;
+  tot = P->N * P->N + 2 * P->N + P->N * 2 * d + 8 * Sd + 11 * S * dd + S + 2 * d + 4 * dd
+        + (S + 2) * (m + m * d + m * dd) + 6 * d + P->r + Sd + P->N + 2 * d + S * S + 2 * d
+        + nsm * nsm + nsm + 2 * d + nout + red->nwork + red->r * red->r + 8;
+  P->Jm = calloc(tot, sizeof(double));
+  P->work = red->rsys.work_size ? malloc(red->rsys.work_size) : NULL;
+  if (P->Jm == NULL || (red->rsys.work_size && P->work == NULL) || dm_rlu_init(&P->lu, P->N)
+      || dm_rlu_init(&P->lu_small, d + m)) {
+    dm_rsprk_free(P);
+    return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+  }
+  p = P->Jm + P->N * P->N;
+#define TAKE(ptr, cnt) do { (ptr) = p; p += (cnt); } while (0)
+  TAKE(P->R, P->N); TAKE(P->X, P->N); TAKE(P->rhs, P->N * 2 * d);
+  TAKE(P->Xs, Sd); TAKE(P->Lq, Sd); TAKE(P->Lv, Sd); TAKE(P->F, Sd); TAKE(P->Sdot, Sd);
+  TAKE(P->ga, Sd); TAKE(P->gkv, Sd); TAKE(P->gib, Sd);
+  TAKE(P->Lvv, S * dd); TAKE(P->Lvq, S * dd); TAKE(P->Lqq, S * dd); TAKE(P->Fq, S * dd);
+  TAKE(P->Fv, S * dd); TAKE(P->gK, S * dd); TAKE(P->gB, S * dd); TAKE(P->gdkv, S * dd);
+  TAKE(P->gdib, S * dd); TAKE(P->D, S * dd); TAKE(P->E, S * dd);
+  TAKE(P->Lval, S);
+  TAKE(P->a0, d); TAKE(P->a1, d); TAKE(P->K0, dd); TAKE(P->K1, dd); TAKE(P->B0, dd); TAKE(P->B1, dd);
+  TAKE(P->g, (S + 2) * m); TAKE(P->G, (S + 2) * m * d); TAKE(P->Hc, (S + 2) * m * dd);
+  TAKE(P->q1w, d); TAKE(P->p1w, d); TAKE(P->v1w, d); TAKE(P->dq, d); TAKE(P->dp, d);
+  TAKE(P->tmp, d); TAKE(P->thd, P->r);
+  TAKE(P->hV, Sd); TAKE(P->hx, P->N); TAKE(P->hq1, d); TAKE(P->hp1, d); TAKE(P->Ex, S * S);
+  TAKE(P->cq, d); TAKE(P->cp, d);
+  TAKE(P->small, nsm * nsm + nsm);
+  TAKE(P->tin, 2 * d); TAKE(P->tout, nout); TAKE(P->twork, red->nwork + red->r * red->r + 8);
+#undef TAKE
+  P->distinct_nodes = 1;
+  for (i = 0; i < S; i++)
+    for (j = 0; j < i; j++)
+      if (fabs(t->c[i] - t->c[j]) < 1e-8)
+        P->distinct_nodes = 0;
+  *out = P;
+  return DM_OK;
+}
+
+/* {==== stage evaluation ================================================= */
+
+static int cb_fail(dm_rsprk *P, int st, const char *what, const double *x, dm_err *e)
+{
+  char bx[200];
+  if (st > 0)
+    return dm_err_set(e, DM_EDOM, "%s is not finite / outside its domain at x = %s", what,
+                      dm_rfmt_vec(bx, sizeof bx, x, P->d));
+  return dm_err_set(e, DM_ECALLBACK, "%s callback failed (status %d) at x = %s", what, st,
+                    dm_rfmt_vec(bx, sizeof bx, x, P->d));
+}
+
+/* muA, kv, ib (and K, B, dkv, dib when jac) at (x, v) into the stage-i slots */
+static int eval_gyro(dm_rsprk *P, size_t i, const double *x, const double *v, int jac, dm_err *e)
+{
+  const dm_routh *red = P->red;
+  size_t d = P->d, dd = P->dd, k;
+  const dm_rprog *pg = jac ? &red->gyro_j : &red->gyro_r;
+  double *o = P->tout;
+  memcpy(P->tin, x, d * sizeof(double));
+  memcpy(P->tin + d, v, d * sizeof(double));
+  dm_rprog_run(pg, P->tin, red->par, o, P->twork);
+  for (k = 0; k < pg->nout; k++)
+    if (!isfinite(o[k]))
+      return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", x, e);
+  memcpy(P->ga + i * d, o, d * sizeof(double));
+  if (!jac) {
+    memcpy(P->gkv + i * d, o + d, d * sizeof(double));
+    memcpy(P->gib + i * d, o + 2 * d, d * sizeof(double));
+    return DM_OK;
+  }
+  memcpy(P->gK + i * dd, o + d, dd * sizeof(double));
+  memcpy(P->gB + i * dd, o + d + dd, dd * sizeof(double));
+  memcpy(P->gkv + i * d, o + d + 2 * dd, d * sizeof(double));
+  memcpy(P->gib + i * d, o + 2 * d + 2 * dd, d * sizeof(double));
+  memcpy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd * sizeof(double));
+  memcpy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd * sizeof(double));
+  return DM_OK;
+}
+
+/* muA and K = d muA/dx at a node point x (velocity 0) */
+static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, double *B, dm_err *e)
+{
+  const dm_routh *red = P->red;
+  size_t d = P->d, dd = P->dd, k;
+  double *o = P->tout;
+  memcpy(P->tin, x, d * sizeof(double));
+  memset(P->tin + d, 0, d * sizeof(double));
+  dm_rprog_run(K ? &red->gyro_j : &red->gyro_r, P->tin, red->par, o, P->twork);
+  for (k = 0; k < (K ? red->gyro_j.nout : d); k++)
+    if (!isfinite(o[k]))
+      return cb_fail(P, 1, "the connection mu^T A", x, e);
+  memcpy(a, o, d * sizeof(double));
+  if (K)
+    memcpy(K, o + d, dd * sizeof(double));
+  if (B)
+    memcpy(B, o + d + dd, dd * sizeof(double));
+  return DM_OK;
+}
+
+static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
+{
+  const dm_system *sys = P->sys;
+  const double *par = P->red->par;
+  size_t d = P->d, dd = P->dd, a, b;
+  double *Xi = P->Xs + i * d, *Vi = P->X + i * d;
+  dm_lag_out o = {0, P->Lq + i * d, P->Lv + i * d, P->Lvv + i * dd, P->Lvq + i * dd,
+                  P->Lqq + i * dd};
+  unsigned what = DM_LAG_L | DM_LAG_Q | DM_LAG_V | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
+  int st = sys->lagrangian(sys->data, Xi, Vi, par, what, &o, P->work);
+  if (st != 0)
+    return cb_fail(P, st, "the Routhian", Xi, e);
+  P->Lval[i] = o.L;
+  if (P->forced) {
+    unsigned fw = DM_FORCE_F | (jac ? (DM_FORCE_Q | DM_FORCE_V) : 0u);
+    st = sys->force(sys->data, Xi, Vi, par, fw, P->F + i * d, P->Fq + i * dd, P->Fv + i * dd, P->work);
+    if (st != 0)
+      return cb_fail(P, st, "the reduced force", Xi, e);
+  }
+  if (P->gyro && (st = eval_gyro(P, i, Xi, Vi, jac, e)) != DM_OK)
+    return st;
+  for (a = 0; a < d; a++)
+    P->Sdot[i * d + a] = P->Lq[i * d + a] - P->gib[i * d + a] + P->F[i * d + a];
+  if (jac)
+    for (a = 0; a < d; a++)
+      for (b = 0; b < d; b++) {
+        size_t k = i * dd + a * d + b;
+        P->D[k] = P->Lqq[k] - P->gdib[k] + P->Fq[k] + P->gdkv[k];
+        P->E[k] = P->Lvq[i * dd + b * d + a] - P->gB[i * dd + b * d + a] + P->Fv[k] + P->gK[k];
+      }
+  return DM_OK;
+}
+
+/* Residual (and the Newton matrix when jac) of the stage equations. */
+static int assemble(dm_rsprk *P, double h, const double *x0, const double *s0, int jac, dm_err *e)
+{
+  size_t d = P->d, S = P->S, dd = P->dd, N = P->N, i, j, k, a, c;
+  const double *A = P->tab->a, *At = P->tab->at;
+  int st;
+  for (i = 0; i < S; i++)
+    for (a = 0; a < d; a++) {
+      double acc = 0.0;
+      for (j = 0; j < S; j++)
+        acc += A[i * S + j] * P->X[j * d + a];
+      P->Xs[i * d + a] = x0[a] + h * acc;
+    }
+  for (i = 0; i < S; i++)
+    if ((st = eval_stage(P, i, jac, e)) != DM_OK)
+      return st;
+  for (i = 0; i < S; i++)
+    for (a = 0; a < d; a++) {
+      double sd = 0.0, kv = 0.0;
+      for (j = 0; j < S; j++) {
+        sd += At[i * S + j] * P->Sdot[j * d + a];
+        kv += At[i * S + j] * P->gkv[j * d + a];
+      }
+      /* S_i = s0 + h sum at Sd + [h sum at K V - (muA(X_i) - muA(x0))] */
+      P->R[i * d + a] = P->Lv[i * d + a] - (s0[a] + h * sd + (h * kv - (P->ga[i * d + a] - P->a0[a])));
+    }
+  if (jac) {
+    memset(P->Jm, 0, N * N * sizeof(double));
+    for (i = 0; i < S; i++)
+      for (k = 0; k < S; k++) {
+        double hak = h * A[i * S + k], hatk = h * At[i * S + k];
+        double *Jb = P->Jm + (i * d) * N + k * d;
+        for (a = 0; a < d; a++)
+          for (c = 0; c < d; c++) {
+            double v = hak * (P->Lvq[i * dd + a * d + c] + P->gK[i * dd + a * d + c])
+                       - hatk * P->E[k * dd + a * d + c];
+            if (i == k)
+              v += P->Lvv[i * dd + a * d + c];
+            for (j = 0; j < S; j++)
+              v -= h * h * At[i * S + j] * A[j * S + k] * P->D[j * dd + a * d + c];
+            Jb[a * N + c] = v;
+          }
+      }
+  }
+  if (P->m)
+    return dm_rsprk_constr_assemble(P, h, x0, jac, e);
+  return DM_OK;
+}
+
+static double update_norm(const dm_rsprk *P, double h, const double *s0)
+{
+  size_t Sd = P->Sd, N = P->N;
+  double ms = dm_rnorm_inf(s0, P->d) + fabs(h) * dm_rnorm_inf(P->Sdot, Sd);
+  double lv = dm_rnorm_inf(P->Lvv, P->S * P->dd);
+  double vs = fmax(fmax(dm_rnorm_inf(P->X, Sd), lv > 0 ? ms / lv : 0.0), DBL_MIN);
+  double dn = dm_rnorm_inf(P->R, Sd) / vs;
+  if (N > Sd) {
+    double xs = fmax(fmax(dm_rnorm_inf(P->X + Sd, N - Sd), ms), DBL_MIN);
+    dn = fmax(dn, dm_rnorm_inf(P->R + Sd, N - Sd) / xs);
+  }
+  return dn;
+}
+
+/* After a failure: a singular locked inertia at a stage explains it best. */
+static int explain(dm_rsprk *P, int st, dm_err *e)
+{
+  size_t i;
+  dm_err e2;
+  for (i = 0; i < P->S; i++)
+    if (dm_routh_check_inertia(P->red, P->Xs + i * P->d, &P->sing_ref, P->twork, "a stage point",
+                               &e2) == DM_ESINGULAR) {
+      if (e)
+        *e = e2;
+      return DM_ESINGULAR;
+    }
+  return st;
+}
+
+static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_integ_stats *stt,
+                  dm_err *e)
+{
+  size_t N = P->N, i;
+  double dn = HUGE_VAL, dbest = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
+  int it, st, stall = 0, ok = 0, jac = 1, njac = 0;
+  for (it = 1; it <= P->maxiter; it++) {
+    if ((st = assemble(P, h, x0, s0, jac, e)) != DM_OK)
+      return explain(P, st, e);
+    rn = dm_rnorm_inf(P->R, N);
+    if (!isfinite(rn))
+      return explain(P, dm_err_set(e, DM_EDOM, "RSPRK: non-finite residual in the stage equations "
+                                   "(h = %g, iteration %d)", h, it), e);
+    if (jac) {
+      njac++;
+      st = dm_rlu_factor(&P->lu, P->Jm, N);
+      if (st != DM_OK)
+        return explain(P, dm_err_set(e, st == DM_EDOM ? DM_EDOM : DM_ESINGULAR,
+                                     "RSPRK: singular Newton matrix of the stage equations (h = %g)%s",
+                                     h, P->m ? "; the constraint gradients may be dependent"
+                                     : "; try a smaller step"), e);
+    }
+    dm_rlu_solve(&P->lu, P->Jm, N, P->R);
+    for (i = 0; i < N; i++)
+      P->X[i] -= P->R[i];
+    dn = update_norm(P, h, s0);
+    if (!isfinite(dn))
+      return explain(P, dm_err_set(e, DM_EDOM, "RSPRK: non-finite Newton update (h = %g)", h), e);
+    if (dn <= P->tol) {
+      ok = 1;
+      break;
+    }
+    if (dn <= NEWTON_ACCEPT && dn > 0.5 * dbest)
+      stall++;
+    if (dn < dbest)
+      dbest = dn;
+    if (stall >= 2) {
+      ok = 1;
+      break;
+    }
+    jac = !P->simplified || dn > 0.1 * dlast;
+    dlast = dn;
+  }
+  if (it > P->maxiter)
+    it = P->maxiter;
+  if (stt) {
+    stt->iters = it;
+    stt->jacs = njac;
+    stt->residual = dn;
+    stt->tol = P->tol;
+    stt->iters_total += it;
+  }
+  if (!ok)
+    return explain(P, dm_err_set(e, DM_ENOCONV, "RSPRK: Newton on the stage equations did not "
+                                 "converge in %d iterations: relative update %.3g > tol %.3g "
+                                 "(residual %.3g, h = %g)", it, dn, P->tol, rn, h), e);
+  if (dn <= 1e-12)
+    return DM_OK;
+  return assemble(P, h, x0, s0, 0, e);
+}
+
+/* {==== predictor ======================================================== */
+
+static double lagrange_basis(size_t s, const double *c, size_t j, double x)
+{
+  double v = 1.0;
+  size_t k;
+  for (k = 0; k < s; k++)
+    if (k != j)
+      v *= (x - c[k]) / (c[j] - c[k]);
+  return v;
+}
+
+int dm_rsprk_velocity(dm_rsprk *P, const double *x, const double *s, double *v, dm_err *e)
+{
+  size_t d = P->d, dd = P->dd;
+  dm_lag_out o = {0, P->Lq, P->Lv, P->Lvv, P->Lvq, P->Lqq};   /* stage-0 slots as scratch */
+  int st;
+  memset(P->v1w, 0, d * sizeof(double));
+  st = P->sys->lagrangian(P->sys->data, x, P->v1w, P->red->par, DM_LAG_V | DM_LAG_VV, &o, P->work);
+  if (st != 0)
+    return cb_fail(P, st, "the Routhian", x, e);
+  if (P->m) {                                      /* lu_small is (d+m): pad with identity */
+    size_t N = d + P->m, i, j;
+    double *M = P->small;
+    memset(M, 0, N * N * sizeof(double));
+    for (i = 0; i < d; i++)
+      for (j = 0; j < d; j++)
+        M[i * N + j] = P->Lvv[i * d + j];
+    for (i = d; i < N; i++)
+      M[i * N + i] = 1.0;
+    if (dm_rlu_factor(&P->lu_small, M, N) != DM_OK)
+      return dm_err_set(e, DM_ESINGULAR, "the reduced kinetic matrix Mtilde is singular");
+    memset(P->small + N * N, 0, N * sizeof(double));
+    for (i = 0; i < d; i++)
+      P->small[N * N + i] = s[i] - P->Lv[i];
+    dm_rlu_solve(&P->lu_small, M, N, P->small + N * N);
+    memcpy(v, P->small + N * N, d * sizeof(double));
+    return DM_OK;
+  }
+  memcpy(P->small, P->Lvv, dd * sizeof(double));
+  if (dm_rlu_factor(&P->lu_small, P->small, d) != DM_OK)
+    return dm_err_set(e, DM_ESINGULAR, "the reduced kinetic matrix Mtilde is singular");
+  {
+    size_t i;
+    for (i = 0; i < d; i++)
+      v[i] = s[i] - P->Lv[i];
+  }
+  dm_rlu_solve(&P->lu_small, P->small, d, v);
+  return DM_OK;
+}
+
+static int predict(dm_rsprk *P, double h, const double *x0, const double *s0, int cont, dm_err *e)
+{
+  size_t d = P->d, S = P->S, Sd = P->Sd, N = P->N, i, j, a;
+  if (cont && P->distinct_nodes) {
+    double rr = h / P->hist_h;
+    if (rr != P->E_ratio) {
+      for (i = 0; i < S; i++)
+        for (j = 0; j < S; j++)
+          P->Ex[i * S + j] = lagrange_basis(S, P->tab->c, j, 1.0 + rr * P->tab->c[i]);
+      P->E_ratio = rr;
+    }
+    for (i = 0; i < S; i++)
+      for (a = 0; a < d; a++) {
+        double acc = 0.0;
+        for (j = 0; j < S; j++)
+          acc += P->Ex[i * S + j] * P->hV[j * d + a];
+        P->X[i * d + a] = acc;
+      }
+  } else if (cont) {
+    memcpy(P->X, P->hV, Sd * sizeof(double));
+  } else {
+    int st = dm_rsprk_velocity(P, x0, s0, P->dq, e);
+    if (st != DM_OK)
+      return st;
+    for (i = 0; i < S; i++)
+      memcpy(P->X + i * d, P->dq, d * sizeof(double));
+  }
+  if (N > Sd) {
+    if (cont)
+      memcpy(P->X + Sd, P->hx, (N - Sd) * sizeof(double));
+    else
+      memset(P->X + Sd, 0, (N - Sd) * sizeof(double));
+  }
+  return DM_OK;
+}
+
+/* {==== the step ========================================================= */
+
+static int finish(dm_rsprk *P, double h, const double *x0, const double *s0, dm_err *e)
+{
+  size_t d = P->d, S = P->S, i, a;
+  const double *b = P->tab->b;
+  int st;
+  for (a = 0; a < d; a++) {
+    double sq = 0.0, sp = 0.0, kv = 0.0;
+    for (i = 0; i < S; i++) {
+      sq += b[i] * P->X[i * d + a];
+      sp += b[i] * P->Sdot[i * d + a];
+      kv += b[i] * P->gkv[i * d + a];
+    }
+    P->dq[a] = h * sq;
+    P->dp[a] = h * sp + h * kv;       /* the -(muA(x1) - muA(x0)) part follows */
+  }
+  if (P->m)
+    return dm_rsprk_constr_finish(P, h, x0, s0, P->q1w, P->p1w, e);
+  kahan(d, x0, P->dq, P->cq, P->q1w);
+  if (P->gyro) {
+    if ((st = eval_node(P, P->q1w, P->a1, NULL, NULL, e)) != DM_OK)
+      return st;
+    for (a = 0; a < d; a++)
+      P->dp[a] -= P->a1[a] - P->a0[a];
+  }
+  kahan(d, s0, P->dp, P->cp, P->p1w);
+  return DM_OK;
+}
+
+/* h sum_j b_j Thetadot_j at the converged stages */
+static void group_increment(dm_rsprk *P, double h, double *dtheta)
+{
+  const dm_routh *red = P->red;
+  size_t d = P->d, r = P->r, j, a;
+  for (a = 0; a < r; a++)
+    dtheta[a] = 0.0;
+  for (j = 0; j < P->S; j++) {
+    memcpy(P->tin, P->Xs + j * d, d * sizeof(double));
+    memcpy(P->tin + d, P->X + j * d, d * sizeof(double));
+    dm_rprog_run(&red->thd, P->tin, red->par, P->thd, P->twork);
+    for (a = 0; a < r; a++)
+      dtheta[a] += h * P->tab->b[j] * P->thd[a];
+  }
+}
+
+int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, double *x1,
+                  double *s1, double *dtheta, dm_integ_stats *stt, dm_err *e)
+{
+  size_t d = P->d, i;
+  int cont = P->hist && memcmp(x0, P->hq1, d * sizeof(double)) == 0
+             && memcmp(s0, P->hp1, d * sizeof(double)) == 0;
+  int st;
+  if (!cont) {
+    memset(P->cq, 0, d * sizeof(double));
+    memset(P->cp, 0, d * sizeof(double));
+  }
+  if (h == 0.0) {
+    memmove(x1, x0, d * sizeof(double));
+    memmove(s1, s0, d * sizeof(double));
+    for (i = 0; dtheta && i < P->r; i++)
+      dtheta[i] = 0.0;
+    return DM_OK;
+  }
+  st = dm_routh_check_inertia(P->red, x0, &P->sing_ref, P->twork, "the initial point", e);
+  if (st == DM_OK && P->gyro)
+    st = eval_node(P, x0, P->a0, NULL, NULL, e);
+  if (st == DM_OK)
+    st = predict(P, h, x0, s0, cont, e);
+  if (st == DM_OK && P->m)
+    st = dm_rsprk_constr_begin(P, x0, e);
+  if (st == DM_OK)
+    st = newton(P, h, x0, s0, stt, e);
+  if (st == DM_OK)
+    st = finish(P, h, x0, s0, e);
+  for (i = 0; st == DM_OK && i < P->S; i++)
+    st = dm_routh_check_inertia(P->red, P->Xs + i * d, &P->sing_ref, P->twork, "a stage point", e);
+  if (st == DM_OK)
+    st = dm_routh_check_inertia(P->red, P->q1w, &P->sing_ref, P->twork, "the end point", e);
+  for (i = 0; st == DM_OK && i < d; i++)
+    if (!isfinite(P->q1w[i]) || !isfinite(P->p1w[i]))
+      st = dm_err_set(e, DM_EDOM, "RSPRK: the step produced a non-finite state (h = %g)", h);
+  if (st != DM_OK) {
+    P->hist = 0;
+    return st;
+  }
+  if (dtheta)
+    group_increment(P, h, dtheta);
+  memcpy(P->hV, P->X, P->Sd * sizeof(double));
+  if (P->N > P->Sd)
+    memcpy(P->hx, P->X + P->Sd, (P->N - P->Sd) * sizeof(double));
+  memcpy(P->hq1, P->q1w, d * sizeof(double));
+  memcpy(P->hp1, P->p1w, d * sizeof(double));
+  P->hist_h = h;
+  P->hist = 1;
+  memcpy(x1, P->q1w, d * sizeof(double));
+  memcpy(s1, P->p1w, d * sizeof(double));
+  if (stt)
+    stt->steps++;
+  return DM_OK;
+}
+
+/* {==== step Jacobian ===================================================== */
+
+int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0, double *DPhi,
+                      dm_integ_stats *stt, dm_err *e)
+{
+  size_t d = P->d, S = P->S, Sd = P->Sd, dd = P->dd, N2 = 2 * d, i, j, k, a, c, y;
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  double *x1 = P->dq, *dX = P->Xs;   /* scratch after the solve: Xs reused for dX */
+  int st;
+  if (P->m)
+    return dm_err_set(e, DM_EUNSUP, "the step Jacobian is not available for constrained systems");
+  if ((st = dm_rsprk_step(P, h, x0, s0, DPhi, DPhi + d, NULL, stt, e)) != DM_OK)
+    return st;
+  memcpy(x1, DPhi, d * sizeof(double));
+  memset(P->K0, 0, dd * sizeof(double));
+  memset(P->K1, 0, dd * sizeof(double));
+  if (P->gyro && ((st = eval_node(P, x0, P->a0, P->K0, NULL, e)) != DM_OK
+                  || (st = eval_node(P, x1, P->a1, P->K1, NULL, e)) != DM_OK))
+    return st;
+  if ((st = assemble(P, h, x0, s0, 1, e)) != DM_OK)
+    return st;
+  if (dm_rlu_factor(&P->lu, P->Jm, Sd) != DM_OK)
+    return dm_err_set(e, DM_ESINGULAR, "RSPRK Jacobian: singular stage matrix (h = %g)", h);
+  for (c = 0; c < N2; c++) {
+    double *dV = P->rhs + c * Sd;
+    for (i = 0; i < S; i++)
+      for (a = 0; a < d; a++) {
+        double v;
+        if (c < d) {
+          v = P->Lvq[i * dd + a * d + c] + P->gK[i * dd + a * d + c] - P->K0[a * d + c];
+          for (j = 0; j < S; j++)
+            v -= h * At[i * S + j] * P->D[j * dd + a * d + c];
+        } else {
+          v = (a == c - d) ? -1.0 : 0.0;
+        }
+        dV[i * d + a] = -v;
+      }
+    dm_rlu_solve(&P->lu, P->Jm, Sd, dV);
+    for (j = 0; j < S; j++)
+      for (a = 0; a < d; a++) {
+        double acc = 0.0;
+        for (k = 0; k < S; k++)
+          acc += A[j * S + k] * dV[k * d + a];
+        dX[j * d + a] = (c < d && a == c ? 1.0 : 0.0) + h * acc;
+      }
+    for (a = 0; a < d; a++) {
+      double dq1 = 0.0;
+      for (j = 0; j < S; j++)
+        dq1 += b[j] * dV[j * d + a];
+      P->tmp[a] = (c == a ? 1.0 : 0.0) + h * dq1;     /* dx1 column c */
+    }
+    for (a = 0; a < d; a++) {
+      double dp1 = 0.0, kk = 0.0;
+      for (j = 0; j < S; j++) {
+        double f = 0.0;
+        for (y = 0; y < d; y++)
+          f += P->D[j * dd + a * d + y] * dX[j * d + y] + P->E[j * dd + a * d + y] * dV[j * d + y];
+        dp1 += b[j] * f;
+      }
+      for (y = 0; y < d; y++)
+        kk += P->K1[a * d + y] * P->tmp[y];
+      DPhi[a * N2 + c] = P->tmp[a];
+      DPhi[(d + a) * N2 + c] = (c == d + a ? 1.0 : 0.0) + h * dp1 - kk
+                               + (c < d ? P->K0[a * d + c] : 0.0);
+    }
+  }
+  P->hist = 0;       /* stage buffers were reused */
+  return DM_OK;
+}

@@ -1,0 +1,231 @@
+/* rsprk_constr.c -- holonomic constraints ghat(y) = 0 on the preshape space
+ * in the RSPRK step (thesis §2.8, Theorems 2.14 / 2.17; spec routh.md §6),
+ * with the multiplier layout of src/core/integrators/prk_constrained.c:
+ * unknowns (Xd_i, Lt_k for the interior stages k of a Lobatto-type tableau,
+ * mu0 on the initial momentum); equations
+ *   r_i + G(x0)^T mu0 + sum_k at_ik G(X_k)^T Lt_k = 0,
+ *   ghat(X_k) / h = 0,   ghat(x1) / h = 0;
+ * then s1 gets - G(x0)^T mu0 - sum_k b_k G(X_k)^T Lt_k and the momentum
+ * projection s1 <- s1 - G(x1)^T mu1 with the velocity tangent to the
+ * constraint manifold.  Every stage point lies on ghat = 0.  The projection
+ * in s equals the projection of the full p_x on J = mu (the connection
+ * term muA(x1) is fixed), so the reduction commutes with RATTLE. */
+#include <config.h>
+#include "rsprk_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+static int lobatto_type(const dm_tableau *t)
+{
+  size_t s = t->s, i;
+  if (s < 2 || t->c[0] != 0.0 || t->c[s - 1] != 1.0)
+    return 0;
+  for (i = 0; i < s; i++)
+    if (t->a[i] != 0.0 || fabs(t->a[(s - 1) * s + i] - t->b[i]) > 1e-14
+        || t->at[i * s + s - 1] != 0.0 || fabs(t->at[i * s] - t->b[0]) > 1e-14)
+      return 0;
+  return 1;
+}
+
+int dm_rsprk_constr_layout(dm_rsprk *P, dm_err *e)
+{
+  const dm_tableau *t = P->tab;
+  size_t k;
+  if (t->s == 1) {
+    P->nK = 0;
+    return DM_OK;
+  }
+  if (lobatto_type(t)) {
+    P->nK = t->s - 2;
+    for (k = 0; k < P->nK; k++)
+      P->K[k] = k + 1;
+    return DM_OK;
+  }
+  return dm_err_set(e, DM_EUNSUP, "constraints on the preshape space are not supported with the "
+                    "%s tableau (s = %zu): use 'lobatto' (multipliers at every stage), 'trapezoid' "
+                    "or 'midpoint'", t->name, t->s);
+}
+
+static int constr(dm_rsprk *P, const double *y, unsigned what, size_t slot, dm_err *e)
+{
+  size_t m = P->m, d = P->d;
+  int st = P->sys->constraints(P->sys->data, y, P->red->par, what, P->g + slot * m,
+                               P->G + slot * m * d, P->Hc + slot * m * d * d, P->work);
+  if (st != 0)
+    return dm_err_set(e, st > 0 ? DM_EDOM : DM_ECALLBACK, "the constraints failed (status %d)", st);
+  return DM_OK;
+}
+
+int dm_rsprk_constr_begin(dm_rsprk *P, const double *x0, dm_err *e)
+{
+  size_t S = P->S, m = P->m;
+  double gn;
+  int st = constr(P, x0, DM_CONSTR_G | DM_CONSTR_DG, S, e);
+  if (st != DM_OK)
+    return st;
+  gn = dm_rnorm_inf(P->g + S * m, m);
+  if (!(gn <= 1e-8 * fmax(1.0, dm_rnorm_inf(x0, P->d))))
+    return dm_err_set(e, DM_EINVAL, "the initial point violates the constraints: |g(x0)| = %.3g "
+                      "(start on g = 0)", gn);
+  return DM_OK;
+}
+
+int dm_rsprk_constr_assemble(dm_rsprk *P, double h, const double *x0, int jac, dm_err *e)
+{
+  size_t d = P->d, S = P->S, m = P->m, dd = P->dd, Sd = P->Sd;
+  size_t N = P->N, offL = Sd, offM = Sd + P->nK * m;
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  const double *G0 = P->G + S * m * d, *mu0 = P->X + offM;
+  double *x1 = P->tmp, *g1 = P->g + (S + 1) * m, *G1 = P->G + (S + 1) * m * d;
+  size_t i, kk, l, a, c, y;
+  int st;
+  for (kk = 0; kk < P->nK; kk++)
+    if ((st = constr(P, P->Xs + P->K[kk] * d,
+                     DM_CONSTR_G | DM_CONSTR_DG | (jac ? DM_CONSTR_D2G : 0u), P->K[kk], e)) != DM_OK)
+      return st;
+  for (a = 0; a < d; a++) {
+    double acc = 0.0;
+    for (l = 0; l < S; l++)
+      acc += b[l] * P->X[l * d + a];
+    x1[a] = x0[a] + h * acc;
+  }
+  if ((st = constr(P, x1, DM_CONSTR_G | DM_CONSTR_DG, S + 1, e)) != DM_OK)
+    return st;
+  for (i = 0; i < S; i++)
+    for (c = 0; c < d; c++) {
+      double acc = 0.0;
+      for (a = 0; a < m; a++)
+        acc += G0[a * d + c] * mu0[a];
+      for (kk = 0; kk < P->nK; kk++) {
+        size_t k = P->K[kk];
+        const double *Gk = P->G + k * m * d, *Lk = P->X + offL + kk * m;
+        for (a = 0; a < m; a++)
+          acc += At[i * S + k] * Gk[a * d + c] * Lk[a];
+      }
+      P->R[i * d + c] += acc;
+    }
+  for (kk = 0; kk < P->nK; kk++)
+    for (a = 0; a < m; a++)
+      P->R[offL + kk * m + a] = P->g[P->K[kk] * m + a] / h;
+  for (a = 0; a < m; a++)
+    P->R[offM + a] = g1[a] / h;
+  if (!jac)
+    return DM_OK;
+  for (kk = 0; kk < P->nK; kk++) {
+    size_t k = P->K[kk];
+    const double *Gk = P->G + k * m * d, *Hk = P->Hc + k * m * dd, *Lk = P->X + offL + kk * m;
+    for (c = 0; c < d; c++)
+      for (y = 0; y < d; y++) {
+        double hs = 0.0;
+        for (a = 0; a < m; a++)
+          hs += Lk[a] * Hk[(a * d + c) * d + y];
+        for (i = 0; i < S; i++)
+          for (l = 0; l < S; l++)
+            P->Jm[(i * d + c) * N + l * d + y] += At[i * S + k] * h * A[k * S + l] * hs;
+      }
+    for (i = 0; i < S; i++)
+      for (c = 0; c < d; c++)
+        for (a = 0; a < m; a++)
+          P->Jm[(i * d + c) * N + offL + kk * m + a] = At[i * S + k] * Gk[a * d + c];
+    for (a = 0; a < m; a++)
+      for (l = 0; l < S; l++)
+        for (y = 0; y < d; y++)
+          P->Jm[(offL + kk * m + a) * N + l * d + y] = A[k * S + l] * Gk[a * d + y];
+  }
+  for (i = 0; i < S; i++)
+    for (c = 0; c < d; c++)
+      for (a = 0; a < m; a++)
+        P->Jm[(i * d + c) * N + offM + a] = G0[a * d + c];
+  for (a = 0; a < m; a++)
+    for (l = 0; l < S; l++)
+      for (y = 0; y < d; y++)
+        P->Jm[(offM + a) * N + l * d + y] = b[l] * G1[a * d + y];
+  return DM_OK;
+}
+
+int dm_rsprk_project(dm_rsprk *P, const double *x1, const double *G1, double *s, dm_err *e)
+{
+  size_t d = P->d, m = P->m, N = d + m, i, a, c;
+  double *M = P->small, *y = P->small + N * N;
+  dm_lag_out o = {0, P->Lq, P->Lv, P->Lvv, P->Lvq, P->Lqq};   /* stage-0 slots as scratch */
+  int st;
+  memset(P->v1w, 0, d * sizeof(double));
+  st = P->sys->lagrangian(P->sys->data, x1, P->v1w, P->red->par, DM_LAG_V | DM_LAG_VV, &o, P->work);
+  if (st != 0)
+    return dm_err_set(e, DM_EDOM, "the Routhian is outside its domain at the end point");
+  memset(M, 0, N * N * sizeof(double));
+  for (c = 0; c < d; c++) {
+    for (i = 0; i < d; i++)
+      M[c * N + i] = P->Lvv[c * d + i];
+    for (a = 0; a < m; a++) {
+      M[c * N + d + a] = G1[a * d + c];
+      M[(d + a) * N + c] = G1[a * d + c];
+    }
+    y[c] = s[c] - P->Lv[c];
+  }
+  for (a = 0; a < m; a++)
+    y[d + a] = 0.0;
+  if (dm_rlu_factor(&P->lu_small, M, N) != DM_OK)
+    return dm_err_set(e, DM_ESINGULAR, "momentum projection onto the constraint manifold: singular "
+                      "system (dependent constraint gradients or singular Mtilde)");
+  dm_rlu_solve(&P->lu_small, M, N, y);
+  for (c = 0; c < d; c++)
+    for (a = 0; a < m; a++)
+      s[c] -= G1[a * d + c] * y[d + a];
+  return DM_OK;
+}
+
+static void kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
+{
+  size_t i;
+  for (i = 0; i < n; i++) {
+    double yy = dx[i] - carry[i];
+    double t = x0[i] + yy;
+    carry[i] = (t - x0[i]) - yy;
+    out[i] = t;
+  }
+}
+
+int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double *s0, double *x1,
+                           double *s1, dm_err *e)
+{
+  const dm_routh *red = P->red;
+  size_t d = P->d, S = P->S, m = P->m, offL = P->Sd, offM = P->Sd + P->nK * m;
+  const double *b = P->tab->b, *G0 = P->G + S * m * d;
+  double *G1 = P->G + (S + 1) * m * d, *pp = s1;   /* s1 is written last */
+  size_t kk, a, c;
+  int st;
+  (void)h;
+  for (c = 0; c < d; c++) {
+    double sp = P->dp[c];
+    for (a = 0; a < m; a++)
+      sp -= G0[a * d + c] * P->X[offM + a];
+    for (kk = 0; kk < P->nK; kk++) {
+      const double *Gk = P->G + P->K[kk] * m * d;
+      for (a = 0; a < m; a++)
+        sp -= b[P->K[kk]] * Gk[a * d + c] * P->X[offL + kk * m + a];
+    }
+    P->dp[c] = sp;
+  }
+  kahan(d, x0, P->dq, P->cq, x1);
+  if (P->gyro) {
+    double *o = P->tout;
+    memcpy(P->tin, x1, d * sizeof(double));
+    memset(P->tin + d, 0, d * sizeof(double));
+    dm_rprog_run(&red->gyro_r, P->tin, red->par, o, P->twork);
+    for (c = 0; c < d; c++)
+      P->dp[c] -= o[c] - P->a0[c];
+  }
+  if ((st = constr(P, x1, DM_CONSTR_G | DM_CONSTR_DG, S + 1, e)) != DM_OK)
+    return st;
+  for (c = 0; c < d; c++)
+    pp[c] = s0[c] + P->dp[c];
+  memcpy(P->tmp, pp, d * sizeof(double));
+  if ((st = dm_rsprk_project(P, x1, G1, P->tmp, e)) != DM_OK)
+    return st;
+  for (c = 0; c < d; c++)
+    P->dp[c] += P->tmp[c] - pp[c];
+  kahan(d, s0, P->dp, P->cp, s1);
+  return DM_OK;
+}
