@@ -128,14 +128,19 @@ long dm_expr_free_vars(dm_expr_ctx *ctx, dm_expr e, dm_expr *out, size_t max);
  * (node, variable) for the life of the context, so derivatives of related
  * expressions share structure. */
 dm_expr dm_expr_diff(dm_expr_ctx *ctx, dm_expr e, dm_expr var);
-/* grad[i] = d e / d vars[i]. */
+/* grad[i] = d e / d vars[i], by reverse accumulation (adjoints): one sweep
+ * for all variables, sharing the chain rule through common
+ * subexpressions; memoised like dm_expr_diff. */
 int dm_expr_grad(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
                  dm_expr *grad, dm_err *err);
 /* J[i*n + j] = d f_i / d vars_j, i < m. */
 int dm_expr_jacobian(dm_expr_ctx *ctx, size_t m, const dm_expr *f, size_t n,
                      const dm_expr *vars, dm_expr *J, dm_err *err);
 /* H[i*n + j] = d2 e / d vars_i d vars_j; the upper triangle is derived and
- * mirrored. */
+ * mirrored.  Rows are gradients of the gradient entries, by reverse sweeps
+ * that stop at preaccumulated shared subexpressions, or by forward
+ * differentiation -- both are built and the one with fewer operations is
+ * kept. */
 int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
                     dm_expr *H, dm_err *err);
 /* sum_i (d e / d vars_i) dir_i. */
