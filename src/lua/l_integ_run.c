@@ -107,14 +107,14 @@ static void progress_end(progress *pg)
  * ======================================================================= */
 
 typedef struct runopts {
-  long nsteps, every;
+  long nsteps, every, chunk;
   double h;
   int progress, energy;
   unsigned char *mom;       /* n flags: momentum columns */
 } runopts;
 
 static const char *const run_keys[] = {"steps", "t", "every", "progress", "energy", "momentum",
-                                       "h", NULL};
+                                       "h", "chunk", NULL};
 
 static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, unsigned char *mom)
 {
@@ -154,7 +154,7 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, double t0, runopts 
       k++;
     if (key == NULL || *k == NULL)
       luaL_error(L, "run: unknown option %s (options: steps, t, every, progress, energy, "
-                 "momentum, h)", luaL_tolstring(L, -2, NULL));
+                 "momentum, h, chunk)", luaL_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
   r->h = li->h;
@@ -187,6 +187,10 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, double t0, runopts 
   if (steps < 1)
     luaL_error(L, "run: every must be >= 1, got %d", (int)steps);
   r->every = (long)steps;
+  steps = dm_optintegerfield(L, o, "chunk", 0);
+  if (steps < 0)
+    luaL_error(L, "run: chunk must be >= 1 (0: adaptive), got %d", (int)steps);
+  r->chunk = (long)steps;
   r->progress = isatty(STDOUT_FILENO) && isatty(STDERR_FILENO);
   if (lua_getfield(L, o, "progress") != LUA_TNIL)
     r->progress = lua_toboolean(L, -1);
@@ -273,21 +277,16 @@ static void add_diagnostics(lua_State *L, dm_linteg *li, dm_traj *tr, const runo
  * the driver
  * ======================================================================= */
 
-/* End of the piece starting at step k: about P steps, on a multiple of
- * every (or inside a long interval between samples), never past nsteps. */
+/* End of the piece starting at step k, about P steps: whole intervals
+ * between samples when k is a sample step, else no further than the next
+ * sample step (so no sample is skipped); never past nsteps. */
 static long piece_end(long k, long P, long every, long nsteps)
 {
-  long end;
-  if (P >= nsteps - k)
-    return nsteps;
-  if (P >= every) {
-    end = (k + P) / every * every;
-    if (end <= k)
-      end = k + every;
-  } else {
-    long next = (k / every + 1) * every;
+  long next = (k / every + 1) * every, end;
+  if (k % every == 0 && P >= every)
+    end = P >= nsteps - k ? nsteps : (k + P) / every * every;
+  else
     end = k + P < next ? k + P : next;
-  }
   return end < nsteps ? end : nsteps;
 }
 
@@ -344,7 +343,7 @@ int dm_linteg_run(lua_State *L)
   memset(&pg, 0, sizeof pg);
   pg.on = r.progress;
   pg.start = pg.last = now();
-  P = pg.on ? (r.every < 64 ? 64 : r.every) : r.nsteps;
+  P = r.chunk > 0 ? r.chunk : pg.on ? (r.every < 64 ? 64 : r.every) : r.nsteps;
   dm_err_clear(&e);
   do {
     long end = piece_end(k, P, r.every, r.nsteps);
@@ -355,13 +354,14 @@ int dm_linteg_run(lua_State *L)
                            k % r.every == 0 || end == k ? r.every : end - k, run_sink, &c,
                            &info, &e);
     k += info.steps;
-    if (pg.on) {
+    if (pg.on && r.chunk == 0) {
       double dt = now() - tp;
       P = dt > 1e-3 ? (long)((double)P * fmin(16.0, fmax(0.5, 0.1 / dt))) : 16 * P;
       if (P < 1)
         P = 1;
-      progress_update(&pg, k, r.nsteps, s.t + (double)k * r.h);
     }
+    if (pg.on)
+      progress_update(&pg, k, r.nsteps, s.t + (double)k * r.h);
   } while (st == DM_OK && k < r.nsteps);
   progress_end(&pg);
 

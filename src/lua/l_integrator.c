@@ -470,8 +470,10 @@ static int integ_tostring(lua_State *L)
     lua_pushfstring(L, " s=%d", s);
     luaL_addvalue(&b);
   }
-  lua_pushfstring(L, " order %d", li->I->order);
-  luaL_addvalue(&b);
+  if (li->I->order > 0) {
+    lua_pushfstring(L, " order %d", li->I->order);
+    luaL_addvalue(&b);
+  }
   if (!isnan(li->h)) {
     dm_fmtnum(num, sizeof num, li->h);
     luaL_addstring(&b, " h=");
@@ -498,10 +500,12 @@ static const dm_reg integ_methods[] = {
    "One step from {q=, p=} or {q=, v=} (t optional) to a new state {t, q, p, v}; a Newton "
    "failure returns nil and a message with the residual and tolerance."},
   {"run", dm_linteg_run,
-   "integ:run(state, {steps= | t=, every=1, progress=, energy=true, momentum={coords}}) -> traj[, message]",
-   "Integrate in C and record every `every` steps a Trajectory with t, q, p, v, energy and "
-   "momentum columns; Ctrl-C or a failure (Newton, NaN) returns the trajectory so far and a "
-   "message saying at which step and time it stopped (and the residual and tolerance)."},
+   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=}) -> traj[, message]",
+   "Integrate in C to step `steps` or time t, recording every `every` steps a Trajectory with "
+   "t, q, p, v, energy and momentum_<coord> columns (cyclic coordinates by default); Ctrl-C or a "
+   "failure (Newton, NaN) returns the trajectory so far and a second value, a message saying at "
+   "which step and time it stopped (with the residual and tolerance); progress (default: stdout "
+   "is a terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
    "step equations (exact Jacobians)."},
