@@ -169,33 +169,32 @@ return function(dm)
 
   def("double_spherical_pendulum",
     "dm.systems.double_spherical_pendulum{g=9.81, l1=1, l2=1, m1=1, m2=1, form=\"cylindrical\"|\"shape\"} -> system",
-    "Double spherical pendulum (spec routh.md 9) in cylindrical coordinates of each bob relative to its pivot, hanging below (z_i = -sqrt(l_i^2 - r_i^2)): coords r1, theta1, r2, theta2, or with form=\"shape\" theta, r1, r2, phi (theta1 = theta, theta2 = theta + phi; theta cyclic for the simultaneous rotation). L = m1|q1dot|^2/2 + m2|q1dot + q2dot|^2/2 - m1 g z1 - m2 g (z1 + z2).",
+    "Double spherical pendulum (spec routh.md 9) in cylindrical coordinates of each bob relative to its pivot, hanging below (z_i = -sqrt(l_i^2 - r_i^2)): coords r1, theta1, r2, theta2, or with form=\"shape\" theta, r1, r2, phi (theta1 = theta, theta2 = theta + phi; theta cyclic for the simultaneous rotation). L = m1|q1dot|^2/2 + m2|q1dot + q2dot|^2/2 - m1 g z1 - m2 g (z1 + z2), written through phi = theta2 - theta1 only.",
     function(o)
       local p, ex = params("double_spherical_pendulum", o, dsp_params, {"form"})
       local shape = (ex.form or "cylindrical") == "shape"
       if ex.form and ex.form ~= "shape" and ex.form ~= "cylindrical" then
         error("dm.systems.double_spherical_pendulum: form must be \"cylindrical\" or \"shape\"", 2)
       end
-      -- position and velocity of one bob relative to its pivot
-      local function bob(r, th, rd, thd, l)
-        local s = dm.sqrt(l^2 - r^2)
-        local c, sn = dm.cos(th), dm.sin(th)
-        return {r * c, r * sn, -s}, {rd * c - r * sn * thd, rd * sn + r * c * thd, r * rd / s}
-      end
       return dm.system{name = "double spherical pendulum", params = p,
         coords = shape and {"theta", "r1", "r2", "phi"} or {"r1", "theta1", "r2", "theta2"},
         L = function(q, v, p)
-          local th1, th2, th1d, th2d
+          local r1, r2, rd1, rd2 = q.r1, q.r2, v.r1, v.r2
+          local phi, w1, w2               -- relative angle, angular velocities
           if shape then
-            th1, th2, th1d, th2d = q.theta, q.theta + q.phi, v.theta, v.theta + v.phi
+            phi, w1, w2 = q.phi, v.theta, v.theta + v.phi
           else
-            th1, th2, th1d, th2d = q.theta1, q.theta2, v.theta1, v.theta2
+            phi, w1, w2 = q.theta2 - q.theta1, v.theta1, v.theta2
           end
-          local x1, w1 = bob(q.r1, th1, v.r1, th1d, p.l1)
-          local x2, w2 = bob(q.r2, th2, v.r2, th2d, p.l2)
-          local T = 0.5 * p.m1 * (sq(w1[1]) + sq(w1[2]) + sq(w1[3]))
-            + 0.5 * p.m2 * (sq(w1[1] + w2[1]) + sq(w1[2] + w2[2]) + sq(w1[3] + w2[3]))
-          return T - p.m1 * p.g * x1[3] - p.m2 * p.g * (x1[3] + x2[3])
+          local s1, s2 = dm.sqrt(p.l1^2 - r1^2), dm.sqrt(p.l2^2 - r2^2)
+          local zd1, zd2 = r1 * rd1 / s1, r2 * rd2 / s2        -- z_i = -s_i
+          local v1sq = rd1^2 + r1^2 * w1^2 + zd1^2
+          local v2sq = rd2^2 + r2^2 * w2^2 + zd2^2
+          -- q1dot . q2dot: horizontal parts rotated by phi, plus the vertical parts
+          local dot = (rd1 * rd2 + r1 * r2 * w1 * w2) * dm.cos(phi)
+            + (r1 * w1 * rd2 - rd1 * r2 * w2) * dm.sin(phi) + zd1 * zd2
+          local T = 0.5 * p.m1 * v1sq + 0.5 * p.m2 * (v1sq + v2sq + 2 * dot)
+          return T + p.m1 * p.g * s1 + p.m2 * p.g * (s1 + s2)
         end}
     end)
 

@@ -191,7 +191,8 @@ static void set_option(lua_State *L, const dm_option_desc *d, const char *fname,
       (d->kind == DM_OPT_BOOL && t != LUA_TBOOLEAN) ||
       (d->kind == DM_OPT_STRING && t != LUA_TSTRING))
     luaL_error(L, "%s: option '%s' must be %s, got %s", fname, d->name, kinds[d->kind],
-               t == LUA_TNUMBER ? "a non-integer number" : luaL_typename(L, -1));
+               t == LUA_TNUMBER && d->kind == DM_OPT_INT ? "a non-integer number"
+                                                         : luaL_typename(L, -1));
   if (d->kind == DM_OPT_STRING) {
     st = dm_integ_opts_set_string(opt, d->name, lua_tostring(L, -1), &e);
   } else {

@@ -177,9 +177,13 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, double t0, runopts 
     r->nsteps = (long)steps;
   } else {
     double T = dm_optnumberfield(L, o, "t", 0), x = (T - t0) / r->h;
-    if (!isfinite(x) || x < -0.5 || x > 9e15)
-      luaL_error(L, "run: the final time t = %f cannot be reached from t0 = %f with h = %f", T, t0,
-                 r->h);
+    if (!isfinite(x) || x < -0.5 || x > 9e15) {
+      char a[32], b[32], c[32];
+      dm_fmtnum(a, sizeof a, T);
+      dm_fmtnum(b, sizeof b, t0);
+      dm_fmtnum(c, sizeof c, r->h);
+      luaL_error(L, "run: the final time t = %s cannot be reached from t0 = %s with h = %s", a, b, c);
+    }
     r->nsteps = lround(x);
   }
   lua_pop(L, 2);
@@ -375,15 +379,16 @@ int dm_linteg_run(lua_State *L)
   lua_settop(L, 5);
   if (st == DM_OK)
     return 1;
+  char tk[32];
+  dm_fmtnum(tk, sizeof tk, s.t + (double)k * r.h);
   if (st == DM_EINTR) {
     dm_interrupt_clear();
-    lua_pushfstring(L, "run: interrupted after step %I of %I (t = %f); the trajectory up to "
-                    "there is returned", (lua_Integer)k, (lua_Integer)r.nsteps,
-                    s.t + (double)k * r.h);
+    lua_pushfstring(L, "run: interrupted after step %I of %I (t = %s); the trajectory up to "
+                    "there is returned", (lua_Integer)k, (lua_Integer)r.nsteps, tk);
   } else {
-    lua_pushfstring(L, "run: step %I of %I from t = %f failed: %s; the trajectory up to there "
-                    "is returned", (lua_Integer)k + 1, (lua_Integer)r.nsteps,
-                    s.t + (double)k * r.h, inner_message(&e));
+    lua_pushfstring(L, "run: step %I of %I from t = %s failed: %s; the trajectory up to there "
+                    "is returned", (lua_Integer)k + 1, (lua_Integer)r.nsteps, tk,
+                    inner_message(&e));
   }
   return 2;
 }

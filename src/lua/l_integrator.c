@@ -105,10 +105,13 @@ double dm_linteg_h(lua_State *L, dm_linteg *li, int idx)
 static void check_finite(lua_State *L, const double *x, size_t n, const char *fname,
                          const char *what)
 {
+  char num[32];
   for (size_t i = 0; i < n; i++)
-    if (!isfinite(x[i]))
-      luaL_error(L, "%s: state.%s contains NaN or Inf (component %d = %f)", fname, what,
-                 (int)i + 1, x[i]);
+    if (!isfinite(x[i])) {
+      dm_fmtnum(num, sizeof num, fabs(x[i]));
+      luaL_error(L, "%s: state.%s contains NaN or Inf (component %d = %s)", fname, what,
+                 (int)i + 1, num);
+    }
 }
 
 void dm_lua_readstate(lua_State *L, dm_lsystem *ls, dm_integrator *I, int idx,

@@ -186,7 +186,7 @@ void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
       int isnum;
       lua_rawgeti(L, idx, (lua_Integer)k + 1);
       out[k] = lua_tonumberx(L, -1, &isnum);
-      if (!isnum)
+      if (!isnum || lua_type(L, -1) != LUA_TNUMBER)
         luaL_error(L, "%s: number expected at index %d, got %s", what, (int)k + 1,
                    luaL_typename(L, -1));
       lua_pop(L, 1);
@@ -207,7 +207,7 @@ void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
     int isnum;
     lua_getfield(L, idx, ls->sys.coords[k]);
     out[k] = lua_tonumberx(L, -1, &isnum);
-    if (!isnum)
+    if (!isnum || lua_type(L, -1) != LUA_TNUMBER)
       luaL_error(L, "%s: %s for coordinate '%s'", what,
                  lua_isnil(L, -1) ? "no value" : "number expected", ls->sys.coords[k]);
     lua_pop(L, 1);

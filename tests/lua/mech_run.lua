@@ -84,7 +84,7 @@ local big = dm.integrator(kep, {method = "gauss", stages = 2, h = 0.8})
 local apo = {q = {-1.6, 0}, p = {0, 0.5}}
 local ptr, msg = big:run(apo, {steps = 100})
 T.ok(ptr ~= nil and #ptr == 4 and ptr:column("t")[4] == 3 * 0.8, "Newton failure at step 4: the 4 samples before are returned")
-T.ok(type(msg) == "string" and msg:find("^run: step 4 of 100 from t = 2.4 failed: Newton") and msg:find("residual")
+T.ok(type(msg) == "string" and msg:find("^run: step 4 of 100 from t = 2.40*4? failed: Newton") and msg:find("residual")
      and msg:find("tol") and msg:find("trajectory up to there is returned"), "the message names step, time, residual and tolerance: " .. tostring(msg))
 local ptr2, msg2 = big:run(apo, {steps = 100, every = 10})
 T.ok(#ptr2 == 2 and ptr2:column("t")[2] == 3 * 0.8 and msg2:find("step 4 of 100"),

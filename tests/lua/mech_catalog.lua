@@ -1,0 +1,149 @@
+-- mech_catalog.lua -- every system of dm.systems: documented, stepped
+-- briefly with its energy bounded, and checked against independent values:
+-- the corrected J2 potential (spec routh.md 8), the same motion in two
+-- coordinate systems, the locked inertia and mechanical connection of the
+-- double spherical pendulum (spec routh.md 9), the built-in C versions.
+local T = require "dmech.test"
+local dm = require "dmech"
+
+local byname = dm.docs()
+local names = {}
+for k in pairs(dm.systems) do names[#names + 1] = k end
+table.sort(names)
+local undocumented = {}
+for _, k in ipairs(names) do
+  local rec = byname["dm.systems." .. k]
+  if not (rec and #rec.doc > 40) then undocumented[#undocumented + 1] = k end
+end
+T.ok(#names >= 12 and #undocumented == 0, ("%d catalog systems, each documented with its physics%s"):format(
+     #names, #undocumented > 0 and (": missing " .. table.concat(undocumented, ", ")) or ""))
+
+-- max |E - E0| over a run
+local function drift(sys, o, s, steps)
+  local tr = dm.integrator(sys, o):run(s, {steps = steps})
+  local E, d = tr:energy(), 0
+  for k = 1, #tr do d = math.max(d, math.abs(E[k] - E[1])) end
+  return d, tr
+end
+
+-- harmonic oscillator: Gauss conserves the quadratic energy to round-off
+local d = drift(dm.systems.harmonic{omega = 2.385}, {method = "gauss", stages = 2, h = 0.1}, {q = {0.7}, v = {0.3}}, 500)
+T.ok(d < 1e-14, ("harmonic, Gauss 2: energy conserved to round-off (%.2g)"):format(d))
+
+-- pendulum (g = l = m = 1) = the built-in pendulum
+local pt = dm.integrator(dm.systems.pendulum{g = 1}, {method = "gauss", stages = 3, h = 0.1}):step{q = {1}, p = {0.5}}
+T.ok(math.abs(pt.q[1] - 1.0457503205397358305) < 1e-13, "pendulum{g=1}: spec T2.2 G3 value")
+d = drift(dm.systems.pendulum{l = 0.8}, {method = "trapezoid", h = 0.01}, {q = {2.385}, v = {0}}, 1000)
+T.ok(d < 1e-2 * 9.81 * 0.8, ("pendulum g=9.81 l=0.8, Stormer-Verlet: energy bounded (%.2g)"):format(d))
+
+-- Kepler in 3-D and in polar coordinates
+d = drift(dm.systems.kepler{dim = 3}, {method = "gauss", stages = 2, h = 0.05}, {q = {0.4, 0, 0.1}, p = {0, 2, 0.3}}, 300)
+T.ok(d < 1e-4, ("Kepler 3-D, Gauss 2: energy bounded (%.2g)"):format(d))
+local pol = dm.systems.kepler_polar()
+T.near(pol:energy({0.4, 0.3}, {0, 5}), dm.systems.kepler():energy({0.4 * math.cos(0.3), 0.4 * math.sin(0.3)},
+       {-2 * math.sin(0.3), 2 * math.cos(0.3)}), 1e-15, "Kepler: polar and Cartesian energies agree")
+d = drift(pol, {method = "lobatto", stages = 3, h = 0.05}, {q = {0.4, 0}, v = {0, 5}}, 300)
+T.ok(d < 1e-4, ("Kepler polar, Lobatto 3: energy bounded (%.2g)"):format(d))
+
+-- J2: the corrected potential, bound orbits, two coordinate systems
+local j2, j2c = dm.systems.j2{J2 = 0.05}, dm.systems.j2_cylindrical{J2 = 0.05}
+local x, y, z = 1.5, 0.4, 0.3
+local R = math.sqrt(x^2 + y^2 + z^2)
+local V = -1 / R + 0.05 / R^3 * (3 * z^2 / (2 * R^2) - 0.5)
+T.near(j2:energy({x, y, z}, {0, 0, 0}), V, 1e-15, "J2: V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (corrected sign)")
+T.near(j2c:energy({math.sqrt(x^2 + y^2), 0.7, z}, {0, 0, 0}), V, 1e-15, "J2 cylindrical: the same potential")
+T.near(j2:energy({x, y, z}, {0.1, 0.2, 0.3}), dm.builtin.j2{J2 = 0.05}:energy({x, y, z}, {0.1, 0.2, 0.3}), 1e-15,
+       "J2 catalog = built-in C")
+local rmin, rmax = math.huge, 0
+d, tr = drift(j2, {method = "gauss", stages = 2, h = 0.05}, {q = {2, 0, 0.3}, v = {0, 0.6, 0.1}}, 2000)
+local X, Y, Z = tr:column("x"), tr:column("y"), tr:column("z")
+for k = 1, #tr do
+  local r = math.sqrt(X[k]^2 + Y[k]^2 + Z[k]^2)
+  rmin, rmax = math.min(rmin, r), math.max(rmax, r)
+end
+T.ok(d < 1e-5 and rmin > 0.5 and rmax < 2.5, ("J2 orbit bound (r in [%.3f, %.3f]), energy error %.2g"):format(rmin, rmax, d))
+local rc = dm.integrator(j2c, {method = "gauss", stages = 2, h = 0.05}):run({q = {2, 0, 0.3}, v = {0, 0.3, 0.1}}, {steps = 2000})
+local dz = math.abs(rc:column("z")[#rc] - Z[#tr])
+T.ok(dz < 1e-5, ("J2 in cylindrical coordinates follows the Cartesian orbit (z differs by %.2g after 100 time units)"):format(dz))
+T.ok(math.abs(rc:momentum("theta")[#rc] - 4 * 0.3) < 1e-13, "J2 cylindrical: J = r^2 thetadot conserved")
+
+-- Henon-Heiles below the escape energy 1/6
+local hh = dm.systems.henon_heiles()
+local s = {q = {0.1, -0.2}, v = {0.3, 0.25}}
+local E0 = hh:energy(s.q, s.v)
+d = drift(hh, {method = "composition", order = 6, h = 0.05}, s, 2000)
+T.ok(E0 < 1 / 6 and d < 1e-6, ("Henon-Heiles (E = %.4f < 1/6): composition 6 energy error %.2g"):format(E0, d))
+
+-- spherical pendulum: angles, R^3, the built-in
+local sp, sp3 = dm.systems.spherical_pendulum{l = 1.3, m = 2}, dm.systems.spherical_pendulum_r3{l = 1.3, m = 2}
+local th, ph, thd, phd = 1.2, 0.3, 0.5, 1.5
+local qc = {1.3 * math.sin(th) * math.cos(ph), 1.3 * math.sin(th) * math.sin(ph), -1.3 * math.cos(th)}
+local vc = {1.3 * (math.cos(th) * math.cos(ph) * thd - math.sin(th) * math.sin(ph) * phd),
+            1.3 * (math.cos(th) * math.sin(ph) * thd + math.sin(th) * math.cos(ph) * phd), 1.3 * math.sin(th) * thd}
+T.near(sp:energy({th, ph}, {thd, phd}), sp3:energy(qc, vc), 1e-14, "spherical pendulum: angles and R^3 energies agree")
+T.near(dm.systems.spherical_pendulum{l = 1.3}:energy({th, ph}, {thd, phd}),
+       dm.builtin.spherical_pendulum{l = 1.3}:energy({th, ph}, {thd, phd}), 1e-14, "spherical pendulum catalog = built-in C")
+local Esp = math.abs(sp:energy({th, ph}, {thd, phd}))
+d = drift(sp, {method = "gauss", stages = 2, h = 0.02}, {q = {th, ph}, v = {thd, phd}}, 500)
+T.ok(d < 1e-5 * Esp, ("spherical pendulum, Gauss 2: energy bounded (%.2g)"):format(d))
+d = drift(dm.systems.spherical_pendulum_r3{l = 1.3, m = 2, form = "norm"}, {method = "trapezoid", h = 0.01}, {q = qc, v = vc}, 500)
+T.ok(d < 2e-3 * Esp, ("spherical pendulum in R^3 (|q| - l form), RATTLE: energy bounded (%.2g)"):format(d))
+
+-- double spherical pendulum: two forms, spec routh.md 9 reference values, R^3 x R^3
+local P = {g = 9.81, l1 = 1.1, l2 = 0.9, m1 = 1.3, m2 = 0.7}
+local cyl, shape, r33 = dm.systems.double_spherical_pendulum(P),
+  dm.systems.double_spherical_pendulum{g = 9.81, l1 = 1.1, l2 = 0.9, m1 = 1.3, m2 = 0.7, form = "shape"},
+  dm.systems.double_spherical_pendulum_r3(P)
+local r1, t1, r2, t2 = 0.5, 0.4, 0.45, 1.3
+local r1d, t1d, r2d, t2d = 0.1, 2.5, -0.2, 3.0
+local phi = t2 - t1
+T.is(table.concat(shape.cyclic, ","), "theta", "shape form: theta (simultaneous rotation) is cyclic")
+T.near(cyl:energy({r1, t1, r2, t2}, {r1d, t1d, r2d, t2d}), shape:energy({t1, r1, r2, phi}, {t1d, r1d, r2d, t2d - t1d}),
+       1e-14, "cylindrical and shape forms: same energy")
+local I = P.m1 * r1^2 + P.m2 * (r1^2 + r2^2 + 2 * r1 * r2 * math.cos(phi))
+local qs = {t1, r1, r2, phi}
+T.near(shape:momentum(qs, {1, 0, 0, 0}, "theta"), I, 1e-14, "locked inertia I = m1 r1^2 + m2 (r1^2 + r2^2 + 2 r1 r2 cos phi)")
+local A = {-r2 * math.sin(phi), r1 * math.sin(phi), r2^2 + r1 * r2 * math.cos(phi)}
+local ok = true
+for i = 1, 3 do
+  local e = {0, 0, 0, 0}
+  e[i + 1] = 1
+  ok = ok and math.abs(shape:momentum(qs, e, "theta") - P.m2 * A[i]) < 1e-14
+end
+T.ok(ok, "mechanical connection I A = m2 (-r2 sin phi, r1 sin phi, r2^2 + r1 r2 cos phi)")
+local function bob(r, t, rd, td, l)
+  local s = math.sqrt(l^2 - r^2)
+  return {r * math.cos(t), r * math.sin(t), -s}, {rd * math.cos(t) - r * math.sin(t) * td,
+          rd * math.sin(t) + r * math.cos(t) * td, r * rd / s}
+end
+local x1, w1 = bob(r1, t1, r1d, t1d, P.l1)
+local x2, w2 = bob(r2, t2, r2d, t2d, P.l2)
+local q6, v6 = {x1[1], x1[2], x1[3], x2[1], x2[2], x2[3]}, {w1[1], w1[2], w1[3], w2[1], w2[2], w2[3]}
+T.near(r33:energy(q6, v6), cyl:energy({r1, t1, r2, t2}, {r1d, t1d, r2d, t2d}), 1e-13,
+       "R^3 x R^3 form: same energy at the same configuration")
+d = drift(cyl, {method = "gauss", stages = 2, h = 0.01}, {q = {r1, t1, r2, t2}, v = {r1d, t1d, r2d, t2d}}, 300)
+T.ok(d < 1e-7, ("double spherical pendulum (cylindrical), Gauss 2: energy bounded (%.2g)"):format(d))
+local dtr
+d, dtr = drift(r33, {method = "lobatto", stages = 3, h = 0.01}, {q = q6, v = v6}, 300)
+local g1 = 0
+local cx1, cy1, cz1 = dtr:column("x1"), dtr:column("y1"), dtr:column("z1")
+local cx2, cy2, cz2 = dtr:column("x2"), dtr:column("y2"), dtr:column("z2")
+for k = 1, #dtr do
+  g1 = math.max(g1, math.abs(math.sqrt(cx1[k]^2 + cy1[k]^2 + cz1[k]^2) - P.l1),
+                math.abs(math.sqrt(cx2[k]^2 + cy2[k]^2 + cz2[k]^2) - P.l2))
+end
+T.ok(d < 1e-5 and g1 < 1e-12, ("R^3 x R^3, Lobatto 3: energy bounded (%.2g), |q_i| = l_i to %.2g"):format(d, g1))
+
+-- damped oscillator loses energy
+local _, dtr2 = drift(dm.systems.damped{c = 0.2}, {method = "midpoint", h = 0.05}, {q = {1}, v = {0}}, 200)
+local E = dtr2:energy()
+T.ok(E[#dtr2] < E[1] * math.exp(-0.2 * 10) * 1.1, "damped oscillator loses energy at the rate c")
+
+-- catalog errors
+T.error_like(function() dm.systems.kepler{mu = 1, J2 = 3} end, "dm.systems.kepler: unknown parameter J2 %(parameters: mu, dim%)",
+             "unknown parameter")
+T.error_like(function() dm.systems.pendulum{g = "9.81"} end, "parameter g must be a number", "non-numeric parameter")
+T.error_like(function() dm.systems.harmonic(3) end, "table of parameters expected", "not a table")
+T.error_like(function() dm.systems.kepler{dim = 4} end, "dim must be 2 or 3", "Kepler dim")
+T.error_like(function() dm.systems.double_spherical_pendulum{form = "polar"} end, "form must be", "double pendulum form")
+T.done()
