@@ -160,7 +160,8 @@ int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_tra
   int st = DM_OK, use_p = 1;
   char key[64];
   *out = NULL;
-  if (!dm_routh_is_integrator(I) || I->sys != &red->sys)
+  dm_routh *owner = NULL;
+  if (!dm_routh_is_integrator(I) || !dm_routh_of_system(I->sys, &owner) || owner != red)
     return dm_err_set(e, DM_EINVAL, "reconstruct: the integrator must be a reduced integrator of "
                       "this reduction");
   if (rt == NULL || dm_traj_ncoords(rt) != d || d > 64)

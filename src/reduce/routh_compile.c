@@ -222,10 +222,18 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
   }
   if ((st = prog_compile(ctx, red, sp, &red->info, ninfo, out, 2 * s, in, e)) != DM_OK)
     goto done;
-  /* the public reduced system */
+  /* one parameter array for every system: a change through any of them
+   * (e.g. a Lua params proxy on the public system) is seen by all */
+  red->fpar_own = red->fsys.par;
+  red->rpar_own = red->rsys.par;
+  red->cpar_own = red->csys.par;
+  red->fsys.par = red->rsys.par = red->csys.par = red->par;
+  /* the public reduced system; never flagged separable, so nothing caches
+   * a mass matrix that a parameter change could make stale */
   red->sys = red->rsys;
   red->sys.name = red->name;
-  red->sys.par = red->par;
+  red->sys.flags &= ~(unsigned)DM_SYS_SEPARABLE;
+  red->sys.mass = NULL;
   red->sys.lagrangian = dm_routh_lag_forward;
   red->sys.force = red->rsys.force ? force_forward : NULL;
   red->sys.constraints = red->rsys.constraints ? constr_forward : NULL;
@@ -248,6 +256,11 @@ void dm_routh_free(dm_routh *red)
   if (red == NULL)
     return;
   dm_routh_release_progs(red);
+  if (red->fpar_own) {             /* give the systems their own arrays back */
+    red->fsys.par = red->fpar_own;
+    red->rsys.par = red->rpar_own;
+    red->csys.par = red->cpar_own;
+  }
   dm_system_release(&red->fsys);
   dm_system_release(&red->rsys);
   dm_system_release(&red->csys);
@@ -279,12 +292,21 @@ int dm_routh_of_system(const dm_system *sys, dm_routh **red)
   return 1;
 }
 
+/* Bring the private parameter copies of the compiled systems up to date
+ * and re-evaluate their constant mass matrices (separable structure). */
 static void refresh(dm_routh *red)
 {
-  dm_lagrangian_refresh(&red->rsys, NULL);
-  dm_lagrangian_refresh(&red->csys, NULL);
-  red->sys.flags = red->rsys.flags;
-  red->sys.mass = red->rsys.mass;
+  dm_system *ss[3] = {&red->fsys, &red->rsys, &red->csys};
+  double *own[3] = {red->fpar_own, red->rpar_own, red->cpar_own};
+  size_t k;
+  memcpy(own[0], red->par, red->npar * sizeof(double));
+  memcpy(own[1], red->par, red->np * sizeof(double));
+  memcpy(own[2], red->par, red->np * sizeof(double));
+  for (k = 0; k < 3; k++) {
+    ss[k]->par = own[k];
+    dm_lagrangian_refresh(ss[k], NULL);
+    ss[k]->par = red->par;
+  }
 }
 
 int dm_routh_set_mu(dm_routh *red, const double *mu, dm_err *e)
@@ -293,10 +315,8 @@ int dm_routh_set_mu(dm_routh *red, const double *mu, dm_err *e)
   for (a = 0; a < red->r; a++)
     if (!isfinite(mu[a]))
       return dm_err_set(e, DM_EINVAL, "momentum mu[%zu] = %g is not finite", a + 1, mu[a]);
-  for (a = 0; a < red->r; a++) {
-    size_t k = red->npar + a;
-    red->par[k] = red->rsys.par[k] = red->csys.par[k] = mu[a];
-  }
+  for (a = 0; a < red->r; a++)
+    red->par[red->npar + a] = mu[a];
   refresh(red);
   return DM_OK;
 }
@@ -305,8 +325,7 @@ int dm_routh_set_param(dm_routh *red, size_t i, double v, dm_err *e)
 {
   if (i >= red->npar)
     return dm_err_set(e, DM_EINVAL, "parameter index %zu out of range 1..%zu", i + 1, red->npar);
-  red->par[i] = red->rsys.par[i] = red->csys.par[i] = red->fsys.par[i] = v;
-  dm_lagrangian_refresh(&red->fsys, NULL);
+  red->par[i] = v;
   refresh(red);
   return DM_OK;
 }

@@ -31,7 +31,10 @@ struct dm_routh {
   int has_gyro;                    /* mu^T A not identically zero */
   int has_force;
   double sing_tol;
-  double *par;                     /* np: original params, then mu */
+  double *par;                     /* np: original params, then mu; shared by
+                                      fsys, rsys, csys and sys (their .par) */
+  double *fpar_own, *rpar_own, *cpar_own;  /* the compiled systems' private
+                                      copies (read by dm_lagrangian_refresh) */
   char **names;                    /* s shape names + np param names */
   dm_system fsys, rsys, csys;      /* compiled full, reduced R, classical Rc */
   dm_system sys;                   /* the public reduced system (forwards to rsys) */
