@@ -135,6 +135,7 @@ void dm_open_expr(lua_State *L);  /* dm.sym, dm.fn, dm.trace, ... (l_expr.c, l_e
 void dm_open_system(lua_State *L);      /* dm.system (l_system.c, l_system.h) */
 void dm_open_builtin(lua_State *L);     /* dm.builtin.*, dm.systems catalog (l_builtin.c) */
 void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.order_estimate, dm.methods */
+void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c); wraps dm.integrator for reductions */
 
 /* ---- module opener ------------------------------------------------------------ */
 

@@ -15,6 +15,7 @@ static const dm_opener openers[] = {
   dm_open_system,
   dm_open_builtin,
   dm_open_integrator,
+  dm_open_reduce,
   NULL
 };
 

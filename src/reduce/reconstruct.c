@@ -130,17 +130,48 @@ int dm_routh_lift(dm_routh *red, const double *theta, const double *x, const dou
   return DM_OK;
 }
 
+int dm_routh_momentum(dm_routh *red, const double *x, const double *xdot, double *s_, dm_err *e)
+{
+  size_t d = red->s;
+  double *w = red->lscratch + 3 * d + d * d;
+  dm_lag_out o;
+  memset(&o, 0, sizeof o);
+  o.Lv = s_;
+  if (red->rsys.lagrangian(red->rsys.data, x, xdot, red->par, DM_LAG_V, &o, w) != 0)
+    return dm_err_set(e, DM_EDOM, "the Routhian is outside its domain at this state");
+  return DM_OK;
+}
+
+int dm_routh_velocity(dm_routh *red, const double *x, const double *s_, double *xdot, dm_err *e)
+{
+  size_t d = red->s, i;
+  double *z = red->lscratch, *Lv = z + d, *M = z + 3 * d, *w = M + d * d;
+  dm_lag_out o;
+  memset(&o, 0, sizeof o);
+  memset(z, 0, d * sizeof(double));
+  o.Lv = Lv;
+  o.Lvv = M;
+  if (red->rsys.lagrangian(red->rsys.data, x, z, red->par, DM_LAG_V | DM_LAG_VV, &o, w) != 0)
+    return dm_err_set(e, DM_EDOM, "the Routhian is outside its domain at this state");
+  if (dm_rlu_factor(&red->lu_s, M, d) != DM_OK)
+    return dm_err_set(e, DM_ESINGULAR, "the reduced kinetic matrix Mtilde is singular here");
+  for (i = 0; i < d; i++)
+    xdot[i] = s_[i] - Lv[i];
+  dm_rlu_solve(&red->lu_s, M, d, xdot);
+  return DM_OK;
+}
+
 /* {==== reconstruction ===================================================== */
 
 /* full velocity from (x, s): xdot from the reduced Legendre map, thetadot =
  * I^{-1} mu - A xdot */
-static int full_velocity(dm_routh *red, dm_integrator *I, const double *x, const double *s_,
-                         double *xd, double *v, dm_err *e)
+static int full_velocity(dm_routh *red, const double *x, const double *s_, double *xd, double *v,
+                         dm_err *e)
 {
   scr S = carve(red);
   size_t d = red->s, r = red->r;
   double thd[DM_ROUTH_RMAX];
-  int st = dm_integrator_velocity(I, x, s_, xd, 0, e);
+  int st = dm_routh_velocity(red, x, s_, xd, e);
   if (st != DM_OK)
     return st;
   memcpy(S.tin, x, d * sizeof(double));
@@ -149,6 +180,19 @@ static int full_velocity(dm_routh *red, dm_integrator *I, const double *x, const
   memcpy(thd, S.tout, r * sizeof(double));
   dm_routh_join(red, thd, xd, v);
   return DM_OK;
+}
+
+int dm_routh_lift_state(dm_routh *red, const double *theta, const double *x, const double *s_,
+                        double *q, double *p, double *v, dm_err *e)
+{
+  size_t d = red->s;
+  double xd[64];
+  int st = dm_routh_lift(red, theta, x, s_, q, p, e);
+  if (st != DM_OK || v == NULL)
+    return st;
+  if (d > 64)
+    return dm_err_set(e, DM_EUNSUP, "lift: more than 64 shape coordinates");
+  return full_velocity(red, x, s_, xd, v, e);
 }
 
 int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_traj *rt,
@@ -191,6 +235,8 @@ int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_tra
     if (dm_traj_meta_at(rt, k, &kk, &vv) == DM_OK)
       st = dm_traj_meta_set(T, kk, vv, e);
   }
+  if (st == DM_OK && red->fsys.name)
+    st = dm_traj_meta_set(T, "system", red->fsys.name, e);
   if (st == DM_OK)
     st = dm_traj_meta_set(T, "reconstructed", dm_routh_integrator_kind(I), e);
   if (st == DM_OK)
@@ -238,7 +284,7 @@ int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_tra
         break;
     }
     if ((st = dm_routh_lift(red, th, x, s_, q, p, e)) != DM_OK ||
-        (st = full_velocity(red, I, x, s_, xd, v, e)) != DM_OK)
+        (st = full_velocity(red, x, s_, xd, v, e)) != DM_OK)
       break;
     st = dm_traj_append(T, tc[k], q, p, v, NULL, e);
   }

@@ -179,6 +179,16 @@ int dm_routh_project_qv(dm_routh *red, const double *q, const double *v, double 
 /* (theta, x, s_) with red's mu -> full (q, p) (either may be NULL). */
 int dm_routh_lift(dm_routh *red, const double *theta, const double *x,
                   const double *s_, double *q, double *p, dm_err *e);
+/* The same with the full velocity v (may be NULL): xdot from the reduced
+ * Legendre map, thetadot = I^{-1} mu - A xdot. */
+int dm_routh_lift_state(dm_routh *red, const double *theta, const double *x,
+                        const double *s_, double *q, double *p, double *v, dm_err *e);
+/* Reduced Legendre map and its inverse: s_ = dR/dxdot (x, xdot) and
+ * Mtilde(x) xdot = s_ (R is mechanical); DM_ESINGULAR for singular Mtilde. */
+int dm_routh_momentum(dm_routh *red, const double *x, const double *xdot, double *s_,
+                      dm_err *e);
+int dm_routh_velocity(dm_routh *red, const double *x, const double *s_, double *xdot,
+                      dm_err *e);
 
 /* {==== integrators ====================================================== */
 

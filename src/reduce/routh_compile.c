@@ -242,7 +242,8 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
   red->nscratch = 8 * red->n + 4 * red->n * red->n + ninfo + red->nwork + 2 * red->np
                   + red->fsys.work_size / sizeof(double) + 1;
   red->scratch = calloc(red->nscratch, sizeof(double));
-  if (red->scratch == NULL)
+  red->lscratch = calloc(3 * s + ss + red->rsys.work_size / sizeof(double) + 1, sizeof(double));
+  if (red->scratch == NULL || red->lscratch == NULL || dm_rlu_init(&red->lu_s, s) != DM_OK)
     st = dm_err_set(e, DM_ENOMEM, "out of memory");
 done:
   free(in);
@@ -272,6 +273,8 @@ void dm_routh_free(dm_routh *red)
   free(red->par);
   free(red->exbuf);
   free(red->scratch);
+  free(red->lscratch);
+  dm_rlu_free(&red->lu_s);
   free(red);
 }
 

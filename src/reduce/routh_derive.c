@@ -188,7 +188,12 @@ static int connection(dm_expr_ctx *c, const dm_routh *red, nodes *N, dm_err *e)
     for (i = 0; i < s; i++)
       Mtx[a * s + i] = N->M[red->cyc[a] * n + red->shape[i]];
   invert(c, r, N->I, N->Iinv, &N->detI);
-  for (a = 0; a < r; a++) {
+  if (r == 1) {               /* the same objects, written as quotients (they print better) */
+    N->w[0] = dm_expr_div(c, N->mu[0], N->I[0]);
+    for (i = 0; i < s; i++)
+      N->A[i] = dm_expr_div(c, Mtx[i], N->I[0]);
+  }
+  for (a = 0; a < r && r > 1; a++) {
     dm_expr acc = zero;
     for (b = 0; b < r; b++)
       acc = sum2(c, acc, N->Iinv[a * r + b], N->mu[b]);
@@ -216,6 +221,8 @@ static int connection(dm_expr_ctx *c, const dm_routh *red, nodes *N, dm_err *e)
   t = zero;
   for (a = 0; a < r; a++)
     t = sum2(c, t, N->mu[a], N->w[a]);
+  if (r == 1)                 /* 1/2 mu^2 / I */
+    t = dm_expr_div(c, dm_expr_powi(c, N->mu[0], 2), N->I[0]);
   N->Vmu = dm_expr_add(c, N->V, dm_expr_mul(c, half, t));
   t = zero;
   for (i = 0; i < s; i++) {

@@ -23,6 +23,13 @@ static inline void dm_rprog_run(const dm_rprog *p, const double *in, const doubl
     dm_tape_eval(p->tape, in, par, out, work);
 }
 
+/* Small dense LU with partial pivoting on a row-major N x N matrix (GSL);
+ * DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
+typedef struct dm_rlu {
+  size_t N;
+  void *perm;                      /* gsl_permutation */
+} dm_rlu;
+
 struct dm_routh {
   char *name;
   size_t n, r, s, m, npar, np;     /* np = npar + r */
@@ -52,6 +59,8 @@ struct dm_routh {
   size_t nwork;                    /* max tape work over the programs */
   double *scratch;                 /* for the evaluation helpers */
   size_t nscratch;
+  double *lscratch;                /* reduced Legendre maps: 3 s + s*s + rsys work */
+  dm_rlu lu_s;                     /* s x s */
 };
 
 /* routh_compile.c: compile the systems and programs from the derived nodes
@@ -90,12 +99,6 @@ static inline void dm_routh_join(const dm_routh *red, const double *theta, const
     q[red->shape[i]] = x[i];
 }
 
-/* Small dense LU with partial pivoting on a row-major N x N matrix (GSL);
- * DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
-typedef struct dm_rlu {
-  size_t N;
-  void *perm;                      /* gsl_permutation */
-} dm_rlu;
 int dm_rlu_init(dm_rlu *lu, size_t N);
 void dm_rlu_free(dm_rlu *lu);
 int dm_rlu_factor(dm_rlu *lu, double *a, size_t N);

@@ -1,0 +1,476 @@
+/* l_reduce_ops.c -- methods of a Routh reduction (see l_reduce.h):
+ * red:set_mu, red:project, red:lift, red:reconstruct, red:phase, red:eval,
+ * red:psi, red:defect, red:integrator.  Scratch memory lives in userdata, so
+ * an argument error never leaks; C integrators made here are boxed in a
+ * userdata whose __gc frees them. */
+#include <config.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "l_reduce.h"
+
+#define IBOX_MT "dmech.routh.ibox"
+
+/* scratch doubles owned by a new userdata (pushed) */
+static double *scratch(lua_State *L, size_t n)
+{
+  double *p = lua_newuserdatauv(L, (n ? n : 1) * sizeof(double), 0);
+  memset(p, 0, (n ? n : 1) * sizeof(double));
+  return p;
+}
+
+static dm_lsystem *sys_of(lua_State *L, int idx, int uv)
+{
+  dm_lsystem *ls;
+  lua_getiuservalue(L, idx, uv);
+  ls = lua_touserdata(L, -1);
+  lua_pop(L, 1);          /* anchored by the reduction */
+  return ls;
+}
+
+/* {==== integrator boxes ================================================= */
+
+static int ibox_gc(lua_State *L)
+{
+  dm_integrator **pp = luaL_checkudata(L, 1, IBOX_MT);
+  dm_integrator_free(*pp);
+  *pp = NULL;
+  return 0;
+}
+
+/* method = "routh:<opts.method or def>", stages, h from the table at opts
+ * (0: none); pushes the box; *h gets opts.h or NAN */
+static dm_integrator *boxed_integrator(lua_State *L, dm_routh *red, int opts, const char *def,
+                                       int def_stages, double *h, const char *fname)
+{
+  dm_integrator **pp = lua_newuserdatauv(L, sizeof *pp, 0);
+  dm_integ_opts o;
+  const char *method = def;
+  dm_err e;
+  int st;
+  *pp = NULL;
+  luaL_setmetatable(L, IBOX_MT);
+  dm_integ_opts_init(&o);
+  o.stages = def_stages;
+  *h = NAN;
+  if (opts) {
+    if (lua_getfield(L, opts, "method") == LUA_TSTRING)
+      method = lua_tostring(L, -1);
+    else if (!lua_isnil(L, -1))
+      luaL_error(L, "%s: option 'method' must be a string", fname);
+    lua_pop(L, 1);
+    if (strncmp(method, "routh:", 6) == 0)
+      method += 6;
+    if (lua_getfield(L, opts, "stages") != LUA_TNIL)
+      o.stages = (int)luaL_checkinteger(L, -1);
+    lua_pop(L, 1);
+    if (lua_getfield(L, opts, "h") != LUA_TNIL)
+      *h = luaL_checknumber(L, -1);
+    lua_pop(L, 1);
+  }
+  if (strcmp(method, "midpoint") == 0 || strcmp(method, "trapezoid") == 0
+      || strcmp(method, "dr") == 0 || strcmp(method, "dr:midpoint") == 0
+      || strcmp(method, "classical:midpoint") == 0 || strcmp(method, "classical:trapezoid") == 0)
+    o.stages = 0;
+  st = dm_routh_integrator_new(red, method, &o, pp, &e);
+  if (st != DM_OK)
+    dm_lua_fail(L, fname, st, &e);
+  return *pp;
+}
+
+/* }====================================================================== */
+
+/* {==== states ============================================================ */
+
+/* Read the full state {q=, p=} | {q=, v=} at idx into q, p (n each). */
+static void read_full_state(lua_State *L, dm_lrouth *u, int self, int idx, double *q, double *p,
+                            const char *fname)
+{
+  dm_lsystem *fs = sys_of(L, self, 2);
+  dm_routh *red = u->red;
+  size_t n = fs->n;
+  luaL_checktype(L, idx, LUA_TTABLE);
+  if (lua_getfield(L, idx, "q") == LUA_TNIL)
+    luaL_error(L, "%s: the full state needs q", fname);
+  dm_lua_system_readvec(L, fs, -1, "state.q", q);
+  lua_pop(L, 1);
+  if (lua_getfield(L, idx, "p") != LUA_TNIL) {
+    dm_lua_system_readvec(L, fs, -1, "state.p", p);
+  } else {
+    double *v = p + n;
+    lua_pop(L, 1);
+    if (lua_getfield(L, idx, "v") == LUA_TNIL)
+      luaL_error(L, "%s: the full state needs p or v", fname);
+    dm_lua_system_readvec(L, fs, -1, "state.v", v);
+    {
+      dm_lag_out o;
+      const dm_system *S = dm_routh_full(red);
+      double *w = scratch(L, S->work_size / sizeof(double) + 1);
+      memset(&o, 0, sizeof o);
+      o.Lv = p;
+      if (S->lagrangian(S->data, q, v, S->par, DM_LAG_V, &o, w) != 0)
+        luaL_error(L, "%s: L is outside its domain at this state", fname);
+      lua_pop(L, 1);
+    }
+  }
+  lua_pop(L, 1);
+}
+
+/* Read a reduced state {q=x, p=s} | {q=x, v=xdot} at idx into x, s. */
+static void read_reduced_state(lua_State *L, dm_lrouth *u, int self, int idx, double *x,
+                               double *s_, double *t, const char *fname)
+{
+  dm_lsystem *rs = sys_of(L, self, 1);
+  dm_err e;
+  int st;
+  luaL_checktype(L, idx, LUA_TTABLE);
+  if (lua_getfield(L, idx, "q") == LUA_TNIL)
+    luaL_error(L, "%s: the reduced state needs q (the shape coordinates)", fname);
+  dm_lua_system_readvec(L, rs, -1, "state.q", x);
+  lua_pop(L, 1);
+  if (t) {
+    *t = 0.0;
+    if (lua_getfield(L, idx, "t") != LUA_TNIL)
+      *t = luaL_checknumber(L, -1);
+    lua_pop(L, 1);
+  }
+  if (lua_getfield(L, idx, "p") != LUA_TNIL) {
+    dm_lua_system_readvec(L, rs, -1, "state.p", s_);
+  } else {
+    double *xd = s_ + rs->n;
+    lua_pop(L, 1);
+    if (lua_getfield(L, idx, "v") == LUA_TNIL)
+      luaL_error(L, "%s: the reduced state needs p (= dR/dxdot) or v", fname);
+    dm_lua_system_readvec(L, rs, -1, "state.v", xd);
+    if ((st = dm_routh_momentum(u->red, x, xd, s_, &e)) != DM_OK)
+      dm_lua_fail(L, fname, st, &e);
+  }
+  lua_pop(L, 1);
+}
+
+static void push_state(lua_State *L, int with_t, double t, const double *q, const double *p,
+                       const double *v, size_t n)
+{
+  lua_createtable(L, 0, 4);
+  if (with_t) {
+    lua_pushnumber(L, t);
+    lua_setfield(L, -2, "t");
+  }
+  dm_pushvec_copy(L, q, n);
+  lua_setfield(L, -2, "q");
+  dm_pushvec_copy(L, p, n);
+  lua_setfield(L, -2, "p");
+  if (v) {
+    dm_pushvec_copy(L, v, n);
+    lua_setfield(L, -2, "v");
+  }
+}
+
+/* }====================================================================== */
+
+static int m_set_mu(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  dm_lsystem *rs = sys_of(L, 1, 1);
+  double mu[DM_ROUTH_RMAX];
+  dm_err e;
+  int st;
+  luaL_checkany(L, 2);
+  dm_lrouth_read_mu(L, 2, x->r, mu, "set_mu");
+  if ((st = dm_routh_set_mu(u->red, mu, &e)) != DM_OK)
+    return dm_lua_fail(L, "set_mu", st, &e);
+  rs->gen++;               /* integrators on the reduced system rebuild their caches */
+  lua_settop(L, 1);
+  return 1;
+}
+
+static int m_project(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  size_t n = x->n, s = x->s, r = x->r;
+  double *buf = scratch(L, 3 * n + 3 * s), *q = buf, *p = q + n, *xx = p + 2 * n, *sx = xx + s;
+  double *xd = sx + s, mu[DM_ROUTH_RMAX], th[DM_ROUTH_RMAX], t = 0;
+  int with_t, st;
+  dm_err e;
+  read_full_state(L, u, 1, 2, q, p, "project");
+  with_t = lua_getfield(L, 2, "t") != LUA_TNIL;
+  if (with_t)
+    t = luaL_checknumber(L, -1);
+  lua_pop(L, 1);
+  if ((st = dm_routh_project(u->red, q, p, xx, sx, mu, th, &e)) != DM_OK)
+    return dm_lua_fail(L, "project", st, &e);
+  if ((st = dm_routh_velocity(u->red, xx, sx, xd, &e)) != DM_OK)   /* Mtilde: mu-free */
+    return dm_lua_fail(L, "project", st, &e);
+  push_state(L, with_t, t, xx, sx, xd, s);
+  dm_lrouth_push_numbers(L, mu, r);
+  dm_lrouth_push_numbers(L, th, r);
+  return 3;
+}
+
+static int m_lift(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  size_t n = x->n, s = x->s;
+  double *buf = scratch(L, 3 * n + 3 * s), *q = buf, *p = q + n, *v = p + n, *xx = v + n;
+  double *sx = xx + s, th[DM_ROUTH_RMAX], t = 0;
+  dm_err e;
+  int st;
+  read_reduced_state(L, u, 1, 2, xx, sx, &t, "lift");
+  dm_lrouth_read_mu(L, 3, x->r, th, "lift (theta)");
+  if ((st = dm_routh_lift_state(u->red, th, xx, sx, q, p, v, &e)) != DM_OK)
+    return dm_lua_fail(L, "lift", st, &e);
+  push_state(L, 1, t, q, p, v, n);
+  return 1;
+}
+
+static int m_reconstruct(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  dm_traj *rt = dm_checktraj(L, 2);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  dm_integrator *I;
+  dm_traj **slot, *out = NULL;
+  double th[DM_ROUTH_RMAX], h;
+  const char *meta;
+  char method[2 * DM_INTEG_STRMAX] = "gauss";
+  int stages = 0, st, opts = lua_isnoneornil(L, 3) ? 0 : 3;
+  dm_err e;
+  if (opts)
+    luaL_checktype(L, 3, LUA_TTABLE);
+  /* defaults from the run that produced the trajectory */
+  if ((meta = dm_traj_meta_get(rt, "method")) != NULL)
+    snprintf(method, sizeof method, "%s", strncmp(meta, "routh:", 6) == 0 ? meta + 6 : meta);
+  if ((meta = dm_traj_meta_get(rt, "stages")) != NULL)
+    stages = atoi(meta);
+  lua_pushstring(L, method);                                   /* anchors the default */
+  I = boxed_integrator(L, u->red, opts, lua_tostring(L, -1), stages, &h, "reconstruct");
+  if (isnan(h))
+    h = (meta = dm_traj_meta_get(rt, "h")) != NULL ? atof(meta) : 0.0;
+  if (opts)
+    lua_getfield(L, 3, "theta");
+  else
+    lua_pushnil(L);
+  dm_lrouth_read_mu(L, -1, x->r, th, "reconstruct (theta)");
+  slot = dm_newtraj(L);
+  st = dm_routh_reconstruct(u->red, I, h, rt, th, &out, &e);
+  *slot = out;
+  if (st != DM_OK && st != DM_EINTR)
+    return dm_lua_fail(L, "reconstruct", st, &e);
+  if (st == DM_EINTR) {
+    lua_pushstring(L, e.msg);
+    return 2;
+  }
+  return 1;
+}
+
+static int m_phase(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  dm_traj *loop = dm_checktraj(L, 2);
+  size_t r = dm_routh_exprs_get(u->red)->r;
+  double dyn[DM_ROUTH_RMAX], geo[DM_ROUTH_RMAX], gap;
+  dm_err e;
+  int st = dm_routh_phase(u->red, loop, dyn, geo, &gap, &e);
+  if (st != DM_OK)
+    return dm_lua_fail(L, "phase", st, &e);
+  dm_lrouth_push_numbers(L, dyn, r);
+  dm_lrouth_push_numbers(L, geo, r);
+  lua_pushnumber(L, gap);
+  return 3;
+}
+
+static void push_mat(lua_State *L, const double *a, size_t rows, size_t cols)
+{
+  gsl_matrix *M;
+  size_t i, j;
+  if (rows == 1 || cols == 1) {
+    dm_lrouth_push_numbers(L, a, rows * cols);
+    return;
+  }
+  M = dm_pushmat(L, rows, cols);
+  for (i = 0; i < rows; i++)
+    for (j = 0; j < cols; j++)
+      gsl_matrix_set(M, i, j, a[i * cols + j]);
+}
+
+static int m_eval(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  dm_lsystem *rs = sys_of(L, 1, 1);
+  size_t r = x->r, s = x->s;
+  double *buf = scratch(L, 2 * s + 2 * r * r + 2 * r * s + 2 * r + s + 2 * s * s);
+  double *xx = buf, *xd = xx + s, *I = xd + s, *Ii = I + r * r, *A = Ii + r * r, *w = A + r * s;
+  double *muA = w + r, *Mt = muA + s, *B = Mt + s * s, *thd = B + s * s;
+  dm_routh_vals v;
+  dm_err e;
+  int st;
+  dm_lua_system_readvec(L, rs, 2, "x", xx);
+  if (!lua_isnoneornil(L, 3))
+    dm_lua_system_readvec(L, rs, 3, "xdot", xd);
+  v.I = I; v.Iinv = Ii; v.A = A; v.Iinv_mu = w; v.muA = muA; v.Mtilde = Mt; v.B = B;
+  v.thetadot = thd;
+  if ((st = dm_routh_eval(u->red, xx, xd, &v, &e)) != DM_OK)
+    return dm_lua_fail(L, "eval", st, &e);
+  lua_createtable(L, 0, 13);
+  push_mat(L, I, r, r); lua_setfield(L, -2, "I");
+  push_mat(L, Ii, r, r); lua_setfield(L, -2, "Iinv");
+  if (r == 1)
+    dm_pushvec_copy(L, A, s);
+  else
+    push_mat(L, A, r, s);
+  lua_setfield(L, -2, "A");
+  dm_lrouth_push_numbers(L, w, r); lua_setfield(L, -2, "Iinv_mu");
+  dm_pushvec_copy(L, muA, s); lua_setfield(L, -2, "muA");
+  push_mat(L, Mt, s, s); lua_setfield(L, -2, "Mtilde");
+  push_mat(L, B, s, s); lua_setfield(L, -2, "B");
+  dm_lrouth_push_numbers(L, thd, r); lua_setfield(L, -2, "thetadot");
+  lua_pushnumber(L, v.detI); lua_setfield(L, -2, "detI");
+  lua_pushnumber(L, v.V); lua_setfield(L, -2, "V");
+  lua_pushnumber(L, v.Vmu); lua_setfield(L, -2, "amended");
+  lua_pushnumber(L, v.R); lua_setfield(L, -2, "routhian");
+  lua_pushnumber(L, v.Rc); lua_setfield(L, -2, "classical");
+  return 1;
+}
+
+static int m_psi(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  dm_lsystem *rs = sys_of(L, 1, 1);
+  size_t s = x->s;
+  double *buf = scratch(L, 2 * s), psi[DM_ROUTH_RMAX], h = luaL_checknumber(L, 4);
+  const char *method = "midpoint";
+  int stages = 2, st;
+  dm_tableau *t = NULL;
+  dm_routh_dr *dr = NULL;
+  dm_err e;
+  dm_lua_system_readvec(L, rs, 2, "x0", buf);
+  dm_lua_system_readvec(L, rs, 3, "x1", buf + s);
+  if (!lua_isnoneornil(L, 5)) {
+    luaL_checktype(L, 5, LUA_TTABLE);
+    method = dm_optstringfield(L, 5, "method", method);
+    stages = (int)dm_optintegerfield(L, 5, "stages", stages);
+  }
+  if (strcmp(method, "gauss") == 0)
+    st = dm_tableau_gauss((size_t)stages, &t, &e);
+  else if (strcmp(method, "lobatto") == 0)
+    st = dm_tableau_lobatto((size_t)stages, &t, &e);
+  else if (strcmp(method, "midpoint") == 0)
+    st = DM_OK;
+  else
+    return luaL_error(L, "psi: method must be midpoint, gauss or lobatto, got '%s'", method);
+  if (st == DM_OK)
+    st = dm_routh_dr_alloc(u->red, t, 0, 0, &dr, &e);
+  if (st == DM_OK)
+    st = dm_routh_dr_psi(dr, h, buf, buf + s, psi, NULL, &e);
+  dm_routh_dr_free(dr);
+  dm_tableau_free(t);
+  if (st != DM_OK)
+    return dm_lua_fail(L, "psi", st, &e);
+  dm_lrouth_push_numbers(L, psi, x->r);
+  return 1;
+}
+
+static int m_defect(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  size_t s = x->s;
+  double *buf = scratch(L, 3 * s), h, def;
+  dm_integrator *I;
+  dm_err e;
+  int st;
+  read_reduced_state(L, u, 1, 2, buf, buf + s, NULL, "defect");
+  luaL_checktype(L, 3, LUA_TTABLE);
+  I = boxed_integrator(L, u->red, 3, "gauss", 2, &h, "defect");
+  if (isnan(h) || h == 0.0)
+    return luaL_error(L, "defect: give the step h in the options");
+  if ((st = dm_routh_symplecticity_defect(I, h, buf, buf + s, &def, &e)) != DM_OK)
+    return dm_lua_fail(L, "defect", st, &e);
+  lua_pushnumber(L, def);
+  return 1;
+}
+
+void dm_lrouth_integrator(lua_State *L, int idx, int opts)
+{
+  const char *method = "gauss";
+  idx = lua_absindex(L, idx);
+  if (opts)
+    opts = lua_absindex(L, opts);
+  if (lua_getfield(L, LUA_REGISTRYINDEX, DM_ROUTH_ORIG_INTEGRATOR) != LUA_TFUNCTION)
+    luaL_error(L, "the integrator binding is not loaded");
+  lua_getiuservalue(L, idx, 1);                                /* the reduced System */
+  lua_newtable(L);
+  if (opts) {
+    luaL_checktype(L, opts, LUA_TTABLE);
+    lua_pushnil(L);
+    while (lua_next(L, opts) != 0) {
+      lua_pushvalue(L, -2);
+      lua_insert(L, -2);
+      lua_settable(L, -4);
+    }
+    if (lua_getfield(L, opts, "method") != LUA_TNIL) {
+      if (lua_type(L, -1) != LUA_TSTRING)
+        luaL_error(L, "dm.integrator: option 'method' must be a string, got %s", luaL_typename(L, -1));
+      method = lua_tostring(L, -1);
+    }
+    lua_pop(L, 1);
+  }
+  if (strncmp(method, "routh:", 6) == 0)
+    lua_pushstring(L, method);
+  else
+    lua_pushfstring(L, "routh:%s", method);
+  lua_setfield(L, -2, "method");
+  lua_call(L, 2, 1);
+}
+
+static int m_integrator(lua_State *L)
+{
+  dm_lrouth_check(L, 1);
+  dm_lrouth_integrator(L, 1, lua_isnoneornil(L, 2) ? 0 : 2);
+  return 1;
+}
+
+const dm_reg dm_lrouth_methods[] = {
+  {"set_mu", m_set_mu, "red:set_mu(mu) -> red",
+   "Set the momentum value (a number, or one per cyclic coordinate) without re-deriving anything."},
+  {"project", m_project, "red:project{q=, p= | v= [, t=]} -> reduced_state, mu, theta",
+   "Project a full state: x = shape part, s = p_x - mu^T A(x), mu = p_theta (the state's own), theta; "
+   "the reduced state is {q = x, p = s, v = xdot}."},
+  {"lift", m_lift, "red:lift(reduced_state[, theta]) -> {t=, q=, p=, v=}",
+   "The full state over a reduced state (x, s) with the current mu: p_theta = mu, p_x = s + mu^T A, "
+   "thetadot = I^-1 mu - A xdot."},
+  {"reconstruct", m_reconstruct,
+   "red:reconstruct(traj[, {theta=, method=, stages=, h=}]) -> trajectory",
+   "The full trajectory over a reduced one: theta advanced by the reduced integrator's group "
+   "increments between samples (Hamiltonian side for RSPRK, psi_mu for dr and classical); method, "
+   "stages and h default to the run that made traj."},
+  {"phase", m_phase, "red:phase(loop) -> dynamic, geometric, gap",
+   "Split the group advance over a (closed) shape loop into the dynamic part sum dt I^-1 mu and the "
+   "geometric part -sum A(xbar) dx (midpoint rule); gap is the loop's closure defect."},
+  {"eval", m_eval, "red:eval(x[, xdot]) -> {I=, Iinv=, A=, B=, Mtilde=, amended=, routhian=, ...}",
+   "Numerical values of the derived objects at a shape point with the current mu."},
+  {"psi", m_psi, "red:psi(x0, x1, h[, {method = \"midpoint\" | \"gauss\" | \"lobatto\", stages=}]) -> dtheta",
+   "The discrete reconstruction psi_mu(x0, x1): the group step with discrete momentum J_d = mu "
+   "(closed form for the midpoint rule, Newton for Galerkin)."},
+  {"defect", m_defect, "red:defect(reduced_state, {method=, stages=, h=}) -> number",
+   "Non-canonical symplecticity defect |DPhi^T W(x1) DPhi - W(x0)| of one reduced step, "
+   "W = [[-B, I], [-I, 0]] (the form Omega_S - beta_mu)."},
+  {"integrator", m_integrator, "red:integrator{method=, stages=, h=, ...} -> integrator",
+   "Same as dm.integrator(red, opts): RSPRK, dr or classical on the reduced system."},
+  {NULL, NULL, NULL, NULL}
+};
+
+static const luaL_Reg ibox_meta[] = {{"__gc", ibox_gc}, {NULL, NULL}};
+
+void dm_lrouth_open_boxes(lua_State *L)
+{
+  luaL_newmetatable(L, IBOX_MT);
+  luaL_setfuncs(L, ibox_meta, 0);
+  lua_pop(L, 1);
+}
