@@ -62,9 +62,11 @@ static size_t read_cyclic(lua_State *L, const dm_lsystem *ls, int o, size_t *cyc
       luaL_error(L, "dm.routh: cyclic[%d] must be a coordinate name, got %s", (int)k,
                  luaL_typename(L, -1));
     i = dm_lua_system_coord(ls, lua_tostring(L, -1));
-    if (i < 0)
-      luaL_error(L, "dm.routh: no coordinate '%s' in system '%s' (coordinates: %s)",
-                 lua_tostring(L, -1), ls->sys.name, dm_lsystem_names(L, ls->sys.coords, ls->n));
+    if (i < 0) {
+      const char *bad = lua_tostring(L, -1);
+      luaL_error(L, "dm.routh: no coordinate '%s' in system '%s' (coordinates: %s)", bad,
+                 ls->sys.name, dm_lsystem_names(L, ls->sys.coords, ls->n));
+    }
     cyc[r++] = (size_t)i;
     lua_pop(L, 1);
   }
@@ -283,7 +285,7 @@ static void push_connection(lua_State *L, const dm_routh *red)
   set_tostring(L, "routh connection");
 }
 
-static void push_form2(lua_State *L, const dm_routh *red)
+static void push_form2(lua_State *L, dm_routh *red)
 {
   const dm_routh_exprs *x = dm_routh_exprs_get(red);
   const dm_system *sys = dm_routh_system(red);
@@ -298,7 +300,7 @@ static void push_form2(lua_State *L, const dm_routh *red)
   luaL_buffinit(L, &b);
   for (i = 0; i < s; i++)
     for (j = i + 1; j < s; j++) {
-      if (is_zero(c, x->B[i * s + j]))
+      if (dm_routh_vanishes(red, c, x->B[i * s + j]))    /* e.g. zero by Euler's theorem */
         continue;
       if (k++)
         luaL_addstring(&b, " + ");
@@ -376,7 +378,7 @@ static const char *const fields =
 static int r_index(lua_State *L)
 {
   dm_lrouth *u = dm_lrouth_check(L, 1);
-  const dm_routh *red = u->red;
+  dm_routh *red = u->red;
   const dm_routh_exprs *x = dm_routh_exprs_get(red);
   const dm_system *rs = dm_routh_system(red), *fs = dm_routh_full(red);
   const char *k = luaL_checkstring(L, 2);
@@ -484,7 +486,7 @@ static int r_tostring(lua_State *L)
     int zero = 1;
     dm_expr_ctx *c = dm_lua_exprctx(L);
     for (i = 0; i < x->s * x->s; i++)
-      zero &= is_zero(c, x->B[i]);
+      zero &= dm_routh_vanishes(u->red, c, x->B[i]);
     luaL_addstring(&b, zero ? "; beta = 0" : "; magnetic term beta != 0");
   }
   if (x->m) {
@@ -498,25 +500,39 @@ static int r_tostring(lua_State *L)
   return 1;
 }
 
-/* dm.integrator(red | reduced system | system, opts): the reduced methods
- * for a reduction, the binding's own constructor otherwise */
-static int integrator_dispatch(lua_State *L)
+/* is_reduction(x): 1 for a Routh reduction, raises for its reduced System
+ * given alone (core methods would drop the magnetic term), else false */
+static int is_reduction(lua_State *L)
 {
-  dm_lrouth *u = luaL_testudata(L, 1, DM_ROUTH_MT);
-  dm_lsystem *ls = u ? NULL : dm_lua_tosystem(L, 1);
-  if (u == NULL && (ls == NULL || !dm_routh_of_system(&ls->sys, NULL))) {
-    int n = lua_gettop(L);
-    lua_pushvalue(L, lua_upvalueindex(1));
-    lua_insert(L, 1);
-    lua_call(L, n, LUA_MULTRET);
-    return lua_gettop(L);
+  dm_lsystem *ls;
+  if (luaL_testudata(L, 1, DM_ROUTH_MT) != NULL) {
+    dm_lrouth_check(L, 1);
+    lua_pushboolean(L, 1);
+    return 1;
   }
-  if (u == NULL)
+  ls = dm_lua_tosystem(L, 1);
+  if (ls != NULL && dm_routh_of_system(&ls->sys, NULL))
     luaL_argerror(L, 1, "give the Routh reduction (dm.routh) rather than its reduced system");
-  dm_lrouth_check(L, 1);
+  lua_pushboolean(L, 0);
+  return 1;
+}
+
+static int reduced_integrator(lua_State *L)
+{
   dm_lrouth_integrator(L, 1, lua_isnoneornil(L, 2) ? 0 : 2);
   return 1;
 }
+
+/* dm.integrator(red | sys, opts): written in Lua so that the integrator
+ * binding's own function is called (not tail-called) through a local named
+ * `integrator`, keeping its argument errors' function name */
+static const char dispatch_src[] =
+  "local integrator, is_reduction, reduced_integrator = ...\n"
+  "return function(sys, opts, ...)\n"
+  "  if is_reduction(sys) then return reduced_integrator(sys, opts) end\n"
+  "  local a, b = integrator(sys, opts, ...)\n"
+  "  return a, b\n"
+  "end\n";
 
 static const dm_reg routh_funcs[] = {
   {"routh", l_routh, "dm.routh(sys, {cyclic = {\"theta\", ...}[, mu = number | {...}][, native = mode]}) -> routh",
@@ -573,7 +589,12 @@ void dm_open_reduce(lua_State *L)
     if (lua_getfield(L, dmt, "integrator") == LUA_TFUNCTION) {
       lua_pushvalue(L, -1);
       lua_setfield(L, LUA_REGISTRYINDEX, DM_ROUTH_ORIG_INTEGRATOR);
-      lua_pushcclosure(L, integrator_dispatch, 1);
+      if (luaL_loadbuffer(L, dispatch_src, sizeof dispatch_src - 1, "=dm.integrator") != LUA_OK)
+        lua_error(L);
+      lua_insert(L, -2);
+      lua_pushcfunction(L, is_reduction);
+      lua_pushcfunction(L, reduced_integrator);
+      lua_call(L, 3, 1);
       c = lua_gettop(L);
       dm_pushdocs(L);
       if (lua_getfield(L, -1, "dm.integrator") == LUA_TTABLE) {

@@ -20,6 +20,13 @@ static double *scratch(lua_State *L, size_t n)
   return p;
 }
 
+/* the same after dropping everything above the first top arguments */
+static double *scratch_top(lua_State *L, int top, size_t n)
+{
+  lua_settop(L, top);
+  return scratch(L, n);
+}
+
 static dm_lsystem *sys_of(lua_State *L, int idx, int uv)
 {
   dm_lsystem *ls;
@@ -191,7 +198,7 @@ static int m_project(lua_State *L)
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   size_t n = x->n, s = x->s, r = x->r;
-  double *buf = scratch(L, 3 * n + 3 * s), *q = buf, *p = q + n, *xx = p + 2 * n, *sx = xx + s;
+  double *buf = scratch_top(L, 2, 3 * n + 3 * s), *q = buf, *p = q + n, *xx = p + 2 * n, *sx = xx + s;
   double *xd = sx + s, mu[DM_ROUTH_RMAX], th[DM_ROUTH_RMAX], t = 0;
   int with_t, st;
   dm_err e;
@@ -215,7 +222,7 @@ static int m_lift(lua_State *L)
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   size_t n = x->n, s = x->s;
-  double *buf = scratch(L, 3 * n + 3 * s), *q = buf, *p = q + n, *v = p + n, *xx = v + n;
+  double *buf = scratch_top(L, 3, 3 * n + 3 * s), *q = buf, *p = q + n, *v = p + n, *xx = v + n;
   double *sx = xx + s, th[DM_ROUTH_RMAX], t = 0;
   dm_err e;
   int st;
@@ -303,7 +310,7 @@ static int m_eval(lua_State *L)
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   dm_lsystem *rs = sys_of(L, 1, 1);
   size_t r = x->r, s = x->s;
-  double *buf = scratch(L, 2 * s + 2 * r * r + 2 * r * s + 2 * r + s + 2 * s * s);
+  double *buf = scratch_top(L, 3, 2 * s + 2 * r * r + 2 * r * s + 2 * r + s + 2 * s * s);
   double *xx = buf, *xd = xx + s, *I = xd + s, *Ii = I + r * r, *A = Ii + r * r, *w = A + r * s;
   double *muA = w + r, *Mt = muA + s, *B = Mt + s * s, *thd = B + s * s;
   dm_routh_vals v;
@@ -343,7 +350,7 @@ static int m_psi(lua_State *L)
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   dm_lsystem *rs = sys_of(L, 1, 1);
   size_t s = x->s;
-  double *buf = scratch(L, 2 * s), psi[DM_ROUTH_RMAX], h = luaL_checknumber(L, 4);
+  double *buf = scratch_top(L, 5, 2 * s), psi[DM_ROUTH_RMAX], h = luaL_checknumber(L, 4);
   const char *method = "midpoint";
   int stages = 2, st;
   dm_tableau *t = NULL;
@@ -381,7 +388,7 @@ static int m_defect(lua_State *L)
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   size_t s = x->s;
-  double *buf = scratch(L, 3 * s), h, def;
+  double *buf = scratch_top(L, 3, 3 * s), h, def;
   dm_integrator *I;
   dm_err e;
   int st;

@@ -160,6 +160,15 @@ int dm_routh_set_param(dm_routh *red, size_t i, double value, dm_err *e);
 /* Relative threshold of the singular-inertia test (> 0; default 1e-10). */
 int dm_routh_set_sing_tol(dm_routh *red, double tol, dm_err *e);
 
+/* 1 if expression e (of the shape coordinates, their velocities, the
+ * parameters and mu) vanishes identically: a constant 0, or a sum /
+ * difference whose value is below 1e-12 times the size of its two terms at
+ * several pseudo-random points near the current parameters (e.g. the
+ * r1 dr2 component of the double pendulum's beta, zero by Euler's theorem
+ * for the homogeneous I; the simplifier does not see it).  Meant for
+ * display; the derived expressions themselves are never changed. */
+int dm_routh_vanishes(dm_routh *red, dm_expr_ctx *ctx, dm_expr e);
+
 /* Values of the derived objects at (x, xdot) (xdot may be NULL: zeros) with
  * the current mu.  DM_EDOM when a value is not finite. */
 int dm_routh_eval(dm_routh *red, const double *x, const double *xdot,

@@ -376,6 +376,57 @@ int dm_routh_eval(dm_routh *red, const double *x, const double *xdot, dm_routh_v
   return DM_OK;
 }
 
+int dm_routh_vanishes(dm_routh *red, dm_expr_ctx *ctx, dm_expr e)
+{
+  const dm_routh_exprs *x = &red->ex;
+  size_t nv = 2 * x->s + red->np, i, k;
+  dm_expr *vars, parts[3];
+  double *vals, v[3];
+  unsigned long seed = 12345;
+  int op = dm_expr_kind(ctx, e), ok = 1;
+  if (dm_expr_is_const(ctx, e, &v[0]))
+    return v[0] == 0.0;
+  if (op != DM_EXPR_SUB && op != DM_EXPR_ADD)
+    return 0;
+  vars = malloc(nv * sizeof *vars);
+  vals = malloc(nv * sizeof *vals);
+  if (vars == NULL || vals == NULL) {
+    free(vars);
+    free(vals);
+    return 0;
+  }
+  memcpy(vars, x->x, x->s * sizeof *vars);
+  memcpy(vars + x->s, x->xdot, x->s * sizeof *vars);
+  for (i = 0; i < red->npar; i++)
+    vars[2 * x->s + i] = dm_expr_param(ctx, red->names[red->s + i]);
+  memcpy(vars + 2 * x->s + red->npar, x->mu, x->r * sizeof *vars);
+  parts[0] = e;
+  parts[1] = dm_expr_arg(ctx, e, 0);
+  parts[2] = dm_expr_arg(ctx, e, 1);
+  for (k = 0; k < 4 && ok; k++) {
+    for (i = 0; i < nv; i++) {
+      double u;
+      seed = seed * 6364136223846793005UL + 1442695040888963407UL;
+      u = (double)(seed >> 11) / 9007199254740992.0;
+      if (i < x->s)
+        vals[i] = 0.15 + 0.4 * u;                      /* positions */
+      else if (i < 2 * x->s)
+        vals[i] = 2.0 * u - 1.0;                       /* velocities */
+      else
+        vals[i] = red->par[i - 2 * x->s] != 0.0 ? red->par[i - 2 * x->s] * (0.9 + 0.2 * u)
+                                                 : 0.5 + u;
+    }
+    if (dm_expr_eval(ctx, 3, parts, v, nv, vars, vals, NULL) != DM_OK || !isfinite(v[0])
+        || !isfinite(v[1]) || !isfinite(v[2]) || fabs(v[1]) + fabs(v[2]) == 0.0)
+      ok = 0;
+    else
+      ok = fabs(v[0]) <= 1e-12 * (fabs(v[1]) + fabs(v[2]));
+  }
+  free(vars);
+  free(vals);
+  return ok;
+}
+
 /* {==== small numerical helpers ========================================== */
 
 void dm_routh_sym_eig(const double *I, size_t r, double *lmin, double *lmax)
