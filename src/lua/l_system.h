@@ -82,12 +82,17 @@ dm_lsystem *dm_lua_system_new(lua_State *L);
  * list, may be NULL) for systems without expressions. */
 void dm_lua_system_finish(lua_State *L, dm_lsystem *ls, const char *const *cyclic);
 
+/* Push "a, b, c" (n names; "none" when n == 0) and return it, for
+ * messages listing coordinates or parameters. */
+const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n);
+/* Index of the coordinate / parameter named by the string at arg, or raise
+ * "no coordinate 'x' in system 's' (coordinates: ...)". */
+long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg);
+long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg);
+
 /* ---- shared by l_system.c and l_system_obj.c only ---- */
 int dm_lsystem_gc(lua_State *L);
 void dm_lsystem_open_class(lua_State *L);           /* metatables */
 void dm_lsystem_push_params(lua_State *L, int sys); /* sets the params proxy */
-const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n);
-long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg);
-long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg);
 
 #endif

@@ -152,6 +152,36 @@ static void push_strings(lua_State *L, const char *const *s, size_t n, const uns
     }
 }
 
+/* "{a, b, ...}" of a list of expressions (or of such lists). */
+static int exprlist_tostring(lua_State *L)
+{
+  luaL_Buffer b;
+  lua_Integer n = (lua_Integer)lua_rawlen(L, 1);
+  luaL_buffinit(L, &b);
+  luaL_addchar(&b, '{');
+  for (lua_Integer i = 1; i <= n; i++) {
+    lua_rawgeti(L, 1, i);
+    luaL_tolstring(L, -1, NULL);
+    lua_remove(L, -2);
+    luaL_addvalue(&b);
+    if (i < n)
+      luaL_addstring(&b, ", ");
+  }
+  luaL_addchar(&b, '}');
+  luaL_pushresult(&b);
+  return 1;
+}
+
+/* A plain list of expressions that prints as one. */
+static void set_exprlist_mt(lua_State *L)
+{
+  if (luaL_newmetatable(L, "dmech.exprlist")) {
+    lua_pushcfunction(L, exprlist_tostring);
+    lua_setfield(L, -2, "__tostring");
+  }
+  lua_setmetatable(L, -2);
+}
+
 static void push_exprs(lua_State *L, const dm_expr *x, size_t n)
 {
   lua_createtable(L, (int)n, 0);
@@ -159,6 +189,7 @@ static void push_exprs(lua_State *L, const dm_expr *x, size_t n)
     dm_lua_pushexpr(L, x[i]);
     lua_rawseti(L, -2, (lua_Integer)i + 1);
   }
+  set_exprlist_mt(L);
 }
 
 /* Derivatives of L: kind 'q' / 'v' gradient, "vv", "vq", "qq" matrices. */
@@ -183,6 +214,7 @@ static void push_derivative(lua_State *L, dm_lsystem *ls, const char *kind)
     push_exprs(L, H + i * n, n);
     lua_rawseti(L, -2, (lua_Integer)i + 1);
   }
+  set_exprlist_mt(L);
 }
 
 static int expr_field(lua_State *L, dm_lsystem *ls, const char *k)

@@ -29,6 +29,8 @@ T.ok(sat.mechanical and not sat.separable and sat.traced and not sat.forced and 
      "flags: mechanical, not separable (M depends on r), traced, unforced, unconstrained")
 T.ok(tostring(sat.L):find("J2") and tostring(sat.L):find("v_theta"), "sys.L prints the traced formula")
 T.is(tostring(sat.dLdv[2]), "r^2*v_theta", "sys.dLdv[2] = r^2 v_theta")
+T.is(tostring(sat.dLdv), "{v_r, r^2*v_theta, v_z}", "sys.dLdv prints as a list")
+T.is(tostring(sat.d2Ldv2), "{{1, 0, 0}, {0, r^2, 0}, {0, 0, 1}}", "sys.d2Ldv2 prints as a matrix")
 T.is(tostring(sat.d2Ldv2[2][2]), "r^2", "sys.d2Ldv2[2][2] = r^2")
 T.is(tostring(sat.dLdq[2]), "0", "sys.dLdq[2] = 0 (cyclic)")
 T.ok(({["2*r*v_theta"] = 1, ["2*v_theta*r"] = 1})[tostring(sat.d2Ldvdq[2][1])], "sys.d2Ldvdq[2][1] = 2 r v_theta")
@@ -106,6 +108,9 @@ T.ok(not j2c.traced and tostring(j2c):find("built%-in C"), "built-ins say so")
 T.error_like(function() return j2c.L end, "system.L: 'J2 satellite %(Cartesian%)' is a built%-in C system without expressions",
              "expressions of a built-in system: clear error (reduction needs a traced system)")
 T.error_like(function() return j2c.dLdq end, "without expressions", "derivatives of a built-in system")
+T.error_like(function() dm.routh(j2c, {cyclic = {"x"}, mu = 1}) end,
+             "dm.routh needs a system defined by a Lagrangian %(dm.system{...}%); 'J2 satellite %(Cartesian%)' is a built%-in C system without expressions",
+             "reduction refuses a built-in system")
 T.is(table.concat(dm.builtin.spherical_pendulum().cyclic, ","), "phi", "built-in spherical pendulum: phi cyclic")
 T.error_like(function() dm.builtin.kepler{dim = 4} end, "dim must be 2 or 3", "builtin kepler dim")
 T.error_like(function() dm.builtin.j2{j2 = 1} end, "dm.builtin.j2: unknown option j2 %(options: J2%)", "builtin unknown option")
