@@ -160,7 +160,7 @@ int main(int argc, char **argv)
   fprintf(o, "# Kepler e=0.6: exact (Kepler's equation in __float128) at t = 2000*pi rounded to double.\n");
   fprintf(o, "# J2 (J2 = 0.05, q0 = (2, 0, 0.3), p0 = (0, 0.6, 0.1)) at t = 12750: Stormer-Verlet composed to\n");
   fprintf(o, "# order 10 (recursive triple jump, 81 substeps) in __float128, h = 0.00625 (0.025 and 0.0125 for the estimate).\n");
-  fprintf(o, "# Lines: <name> <t> q... p...   and  <name>_f  f(q)...  (acceleration at the end).\n");
+  fprintf(o, "# Lines: <name>_t T;  <name> q... p... at T;  <name>_v dq/dt... dp/dt... at T (to correct for round-off in the end time).\n");
   /* Kepler: exact value, and a validation of the integrator */
   kepler_exact((R)TK, qe, pe);
   {

@@ -18,7 +18,10 @@ local function readtsv(path, header)
     else
       if cols then
         local r = {}
-        for i, c in ipairs(cols) do r[c] = tonumber(w[i]) or w[i] end
+        for i, c in ipairs(cols) do
+          local x = w[i]
+          r[c] = tonumber(x) or ((x == "nan" or x == "-nan") and 0 / 0) or x
+        end
         rows[#rows + 1] = r
       else
         rows[#rows + 1] = w
@@ -106,15 +109,25 @@ for _, prob in ipairs({"kepler", "j2"}) do
     err_series.ylabel = "|(q,p) - reference| at T"
     err_series.logscale = "xy"
     err_series.grid = true
-    err_series.key = "outside right"
+    err_series.key = "bottom left"
     dh_series.title = name .. ": max |H - H0|"
     dh_series.xlabel = "CPU time [s]"
     dh_series.ylabel = "max |H - H0|"
     dh_series.logscale = "xy"
     dh_series.grid = true
     dh_series.key = false
-    dm.plot{err_series, dh_series, layout = "1,2", size = {1500, 560},
-            output = ("%s/b2_%s.png"):format(dir, prob)}
+    local panels = {}
+    if #err_series > 0 then panels[#panels + 1] = err_series end
+    if #dh_series > 0 then panels[#panels + 1] = dh_series end
+    if #panels == 2 then
+      dm.plot{err_series, dh_series, layout = "1,2", size = {1600, 640},
+              output = ("%s/b2_%s.png"):format(dir, prob)}
+    elseif #panels == 1 then
+      panels[1].key = "bottom left"
+      panels[1].output = ("%s/b2_%s.png"):format(dir, prob)
+      panels[1].size = {900, 640}
+      dm.plot(panels[1])
+    end
 
     md("### B2 %s\n", name)
     md("| method | h or tol | steps | CPU s | reps | error at T | max abs dH |")
@@ -193,12 +206,23 @@ do
   local S = readtsv(dir .. "/b3_summary.tsv", false)
   if S and #S > 0 then
     md("### B3 long time (Kepler e=0.6)\n")
-    md("| method | steps | CPU s (unmonitored) | CPU s (dH every step) | max abs dH | max, first 10%% of periods | max, last 10%% | trend of per-period maxima over the run |")
-    md("|---|---:|---:|---:|---:|---:|---:|---:|")
+    md("| method | steps | CPU s (unmonitored) | CPU s (dH every step) | periods | max abs dH | max, first 10%% of periods | max, last 10%% | trend (LSQ slope x periods) |")
+    md("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for _, w in ipairs(S) do
-      md("| %s | %s | %.3f | %.3f | %.3e | %s | %s | %s |", w[2], w[3], tonumber(w[4]), tonumber(w[5]),
-         tonumber(w[6]), w[7] and ("%.3e"):format(tonumber(w[7])) or "-",
-         w[8] and ("%.3e"):format(tonumber(w[8])) or "-", w[9] and ("%.2e"):format(tonumber(w[9])) or "-")
+      local c, n = curves[w[2]] or {}, 0
+      for k in pairs(c) do if k > n then n = k end end
+      local mx, first, last, sx, sy, sxx, sxy = 0, 0, 0, 0, 0, 0, 0
+      local tenth = math.max(1, n // 10)
+      for k = 1, n do
+        local y = c[k] or 0
+        mx = math.max(mx, y)
+        if k <= tenth then first = math.max(first, y) end
+        if k > n - tenth then last = math.max(last, y) end
+        sx, sy, sxx, sxy = sx + k, sy + y, sxx + k * k, sxy + k * y
+      end
+      local slope = n > 1 and (n * sxy - sx * sy) / (n * sxx - sx * sx) or 0 / 0
+      md("| %s | %s | %.3f | %.3f | %d | %.3e | %.3e | %.3e | %.2e |", w[2], w[3], tonumber(w[4]),
+         tonumber(w[5]), n, mx, first, last, slope * n)
     end
     md("")
   end

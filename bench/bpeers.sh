@@ -21,7 +21,7 @@ export XDG_CACHE_HOME="$CACHE"
 status=0
 t_start=$(date +%s)
 
-section() { printf '\n==== %s ====\n' "$*"; }
+section() { printf '\n==== %s  [%s s] ====\n' "$*" "$(( $(date +%s) - t_start ))"; }
 run() { # run <name> <logfile> cmd... : tee output, record failure
   name=$1; log=$2; shift 2
   if "$@" > "$log.tmp" 2>&1; then
