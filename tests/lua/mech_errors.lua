@@ -15,7 +15,7 @@ end
 local function integ(o) return function() return dm.integrator(kep, o) end end
 
 -- methods and options
-err("bad argument #1 to 'integrator' %(system expected, got table%)", "not a system", function() dm.integrator({}, {}) end)
+err("bad argument #1 to '.-' %(system expected, got table%)", "not a system", function() dm.integrator({}, {}) end)
 err("dm.integrator: unknown method 'gaus' %(known: midpoint, gauss, trapezoid, lobatto, prk, composition, rk4, gsl:<stepper>",
     "unknown method lists the known ones", integ{method = "gaus"})
 err("dm.integrator: unknown option stags %(options: method, tableau, stages, h, tol, maxiter", "misspelt option", integ{stags = 2})

@@ -13,6 +13,7 @@ print(msg)
 local x = I:step{q = {0.4, 0}, p = {0, 2}}
 print("after the run", x.t)
 LUA
+rm -f "$T/out" "$T/err"     # the child creates them: never read a stale file
 "$D" "$T/long.lua" > "$T/out" 2> "$T/err" &
 pid=$!
 i=0
