@@ -64,11 +64,13 @@ T.ok(math.abs(order_ref - 4) <= 0.1, ("order against the default reference (Gaus
 local kep = dm.systems.kepler()
 local k0 = {q = {0.4, 0}, p = {0, 2}}
 local symplectic = {
-  {method = "midpoint"}, {method = "gauss", stages = 2}, {method = "gauss", stages = 3},
-  {method = "gauss", stages = 4}, {method = "trapezoid"}, {method = "trapezoid", explicit = false},
+  {method = "midpoint"}, {method = "gauss", stages = 1}, {method = "gauss", stages = 2},
+  {method = "gauss", stages = 3}, {method = "gauss", stages = 4}, {method = "trapezoid"},
+  {method = "trapezoid", explicit = false}, {method = "lobatto", stages = 2},
   {method = "lobatto", stages = 3}, {method = "lobatto", stages = 4},
-  {method = "composition", order = 4}, {method = "composition", order = 6},
-  {method = "composition", order = 8, scheme = "kahanli8"},
+  {method = "composition", order = 4}, {method = "composition", order = 4, base = "midpoint"},
+  {method = "composition", order = 6, scheme = "yoshida6"}, {method = "composition", order = 6, scheme = "kahanli6"},
+  {method = "composition", order = 8, scheme = "mclachlan8"}, {method = "composition", order = 8, scheme = "kahanli8"},
   {method = "prk", tableau = dm.tableau("lobatto", 3)},
 }
 for _, o in ipairs(symplectic) do
