@@ -14,9 +14,11 @@
  *     compensated sums) -- the same algorithm as the integrator's explicit
  *     path.
  *
- * Each variant runs `reps` times; the median ns/step is printed with steps/s
- * and the ratio to the hand-written loop, plus the distance between final
- * states (the loops compute the same numbers up to round-off).  Targets:
+ * Each variant runs `reps` times, the repetitions interleaved across the
+ * variants (after one warm-up round), timed in thread CPU time; the median
+ * ns/step is printed with steps/s and the ratio to the hand-written loop,
+ * plus the distance between final states (the loops compute the same
+ * numbers up to round-off).  Targets:
  * traced native <= 1.3x hand-written, tape <= 4x.
  *
  * usage: bench_mech [reps]   (DMECH_PATH must point at the Lua library) */
@@ -38,10 +40,12 @@
 #include "core/builtin_systems.h"
 #include "core/integrators/integrator.h"
 
+/* CPU time of this thread: the machine may be shared, and time spent
+ * descheduled is not the code's cost. */
 static double now(void)
 {
   struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -362,37 +366,43 @@ static const char script[] =
   "local dm, B, reps = require 'dmech', bench, bench.reps\n"
   "local function median(t) table.sort(t); return t[(#t + 1) // 2] end\n"
   "local function dist(a, b) local d = 0; for i = 1, #a do d = math.max(d, math.abs(a[i] - b[i])) end; return d end\n"
-  "local function final(tr, sys) local e, q, p = tr[#tr], {}, {}\n"
+  "local function final(tr, sys) local q, p = {}, {}\n"
   "  for i, c in ipairs(sys.coords) do q[i], p[i] = tr:column(c)[#tr], tr:column('p_' .. c)[#tr] end\n"
   "  return q, p end\n"
-  "-- the user's path: integ:run, one sample at the end, no diagnostics\n"
-  "local function run(sys, opts, s, n)\n"
+  "-- a variant is a function running n steps and returning seconds, final q, final p\n"
+  "local function user(sys, opts, s, n)   -- the user's path: integ:run, one sample at the end\n"
   "  local I = dm.integrator(sys, opts)\n"
   "  local o = {steps = n, every = n, energy = false, momentum = false, progress = false}\n"
-  "  I:run(s, {steps = n // 20 + 1, every = n, energy = false, momentum = false, progress = false})\n"
-  "  local ts, tr = {}\n"
-  "  for r = 1, reps do local t0 = B.now(); tr = I:run(s, o); ts[r] = (B.now() - t0) / n * 1e9 end\n"
-  "  local q, p = final(tr, sys)\n"
-  "  return median(ts), q, p, I\n"
+  "  return function()\n"
+  "    local t0 = B.now(); local tr = I:run(s, o); local t = B.now() - t0\n"
+  "    local q, p = final(tr, sys); return t, q, p\n"
+  "  end, I\n"
   "end\n"
-  "local function hand(f, n, ...)\n"
-  "  f(...)\n"
-  "  local ts, q, p = {}\n"
-  "  for r = 1, reps do local t; t, q, p = f(...); ts[r] = t / n * 1e9 end\n"
-  "  return median(ts), q, p\n"
-  "end\n"
-  "local function row(name, ns, ref, target, d)\n"
-  "  local ratio = ns / ref\n"
-  "  print(('  %-42s %9.1f %12.4g %8.2f%s   %s'):format(name, ns, 1e9 / ns, ratio,\n"
-  "    target and (ratio <= target and ' ok  ' or ' MISS') .. (' (<= %g)'):format(target) or '            ',\n"
-  "    d and ('|final state - hand| = %.1e'):format(d) or ''))\n"
+  "-- repetitions interleaved across the variants, so that a busy machine\n"
+  "-- disturbs them alike; the first round is a warm-up\n"
+  "local function measure(variants, n)\n"
+  "  local ts = {}\n"
+  "  for r = 0, reps do\n"
+  "    for i, v in ipairs(variants) do\n"
+  "      local t, q, p = v.f()\n"
+  "      v.q, v.p = q, p\n"
+  "      if r > 0 then ts[i] = ts[i] or {}; ts[i][r] = t / n * 1e9 end\n"
+  "    end\n"
+  "  end\n"
+  "  local ref = median(ts[1])\n"
+  "  for i, v in ipairs(variants) do\n"
+  "    local ns = median(ts[i]); local ratio = ns / ref\n"
+  "    local d = i > 1 and ('|final state - hand| = %.1e'):format(math.max(dist(v.q, variants[1].q), dist(v.p, variants[1].p))) or ''\n"
+  "    print(('  %-42s %9.1f %12.4g %8.2f%s   %s'):format(v.name, ns, 1e9 / ns, ratio,\n"
+  "      v.target and ((ratio <= v.target and ' ok  ' or ' MISS') .. (' (<= %g)'):format(v.target)) or '            ', d))\n"
+  "  end\n"
   "end\n"
   "local function header(title)\n"
   "  print(title)\n"
   "  print(('  %-42s %9s %12s %8s'):format('variant', 'ns/step', 'steps/s', 'ratio'))\n"
   "end\n"
   "print('machine: ' .. B.machine())\n"
-  "print(('median of %d runs each; the ratio is to the hand-written C loop'):format(reps))\n"
+  "print(('thread CPU time, median of %d interleaved runs each; the ratio is to the hand-written C loop'):format(reps))\n"
   "print()\n"
   "local function j2sys(native)\n"
   "  return dm.system{name = 'J2', coords = {'x', 'y', 'z'}, params = {J2 = 0.05}, native = native,\n"
@@ -406,17 +416,14 @@ static const char script[] =
   "local s = {q = {2, 0, 0.3}, p = {0, 0.6, 0.1}}\n"
   "local g2 = {method = 'gauss', stages = 2, h = 0.05}\n"
   "header(('J2 satellite (Cartesian), Gauss s=2, h = 0.05, %d steps'):format(N))\n"
-  "local th, hq, hp, it = hand(B.gauss2_j2, N, s.q, s.p, 0.05, N, 0.05)\n"
-  "row('hand-written C Gauss-2 loop', th, th)\n"
-  "local tc, cq = hand(B.capi, N, 'j2', 'gauss', 2, 0.05, s.q, s.p, N)\n"
-  "row('C API: built-in J2, dm_integrator_run', tc, th, nil, dist(cq, hq))\n"
-  "local tb, bq, bp, bI = run(dm.builtin.j2{J2 = 0.05}, g2, s, N)\n"
-  "row('dmech, built-in C J2 system', tb, th, nil, dist(bq, hq))\n"
-  "local nat = j2sys('always')\n"
-  "local tn, nq = run(nat, g2, s, N)\n"
-  "row('dmech, traced L, native code', tn, th, 1.3, dist(nq, hq))\n"
-  "local tt, tq = run(j2sys(false), g2, s, N)\n"
-  "row('dmech, traced L, tape', tt, th, 4, dist(tq, hq))\n"
+  "local fb, bI = user(dm.builtin.j2{J2 = 0.05}, g2, s, N)\n"
+  "measure({\n"
+  "  {name = 'hand-written C Gauss-2 loop', f = function() return B.gauss2_j2(s.q, s.p, 0.05, N, 0.05) end},\n"
+  "  {name = 'C API: built-in J2, dm_integrator_run', f = function() return B.capi('j2', 'gauss', 2, 0.05, s.q, s.p, N) end},\n"
+  "  {name = 'dmech, built-in C J2 system', f = fb},\n"
+  "  {name = 'dmech, traced L, native code', f = user(j2sys('always'), g2, s, N), target = 1.3},\n"
+  "  {name = 'dmech, traced L, tape', f = user(j2sys(false), g2, s, N), target = 4},\n"
+  "}, N)\n"
   "print(('  Newton iterations per step: hand %.2f, dmech %.2f'):format(select(4, B.gauss2_j2(s.q, s.p, 0.05, N, 0.05)) / N,\n"
   "  bI.stats.iters_total / bI.stats.steps))\n"
   "print()\n"
@@ -428,16 +435,13 @@ static const char script[] =
   "    L = function(q, v) return 0.5 * (v.x^2 + v.y^2) + 1 / dm.sqrt(q.x^2 + q.y^2) end}\n"
   "end\n"
   "header(('Kepler e = 0.6, Stormer-Verlet, h = 0.01, %d steps'):format(M))\n"
-  "local lh, lq = hand(B.leapfrog, M, k.q, k.p, 0.01, M)\n"
-  "row('hand-written C leapfrog', lh, lh)\n"
-  "local kc, kcq = hand(B.capi, M, 'kepler', 'trapezoid', 0, 0.01, k.q, k.p, M)\n"
-  "row('C API: built-in Kepler, dm_integrator_run', kc, lh, nil, dist(kcq, lq))\n"
-  "local kb, kq = run(dm.builtin.kepler(), sv, k, M)\n"
-  "row('dmech, built-in C Kepler system', kb, lh, nil, dist(kq, lq))\n"
-  "local kn, knq = run(kep('always'), sv, k, M)\n"
-  "row('dmech, traced L, native code', kn, lh, 1.3, dist(knq, lq))\n"
-  "local kt, ktq = run(kep(false), sv, k, M)\n"
-  "row('dmech, traced L, tape', kt, lh, 4, dist(ktq, lq))\n";
+  "measure({\n"
+  "  {name = 'hand-written C leapfrog', f = function() return B.leapfrog(k.q, k.p, 0.01, M) end},\n"
+  "  {name = 'C API: built-in Kepler, dm_integrator_run', f = function() return B.capi('kepler', 'trapezoid', 0, 0.01, k.q, k.p, M) end},\n"
+  "  {name = 'dmech, built-in C Kepler system', f = user(dm.builtin.kepler(), sv, k, M)},\n"
+  "  {name = 'dmech, traced L, native code', f = user(kep('always'), sv, k, M), target = 1.3},\n"
+  "  {name = 'dmech, traced L, tape', f = user(kep(false), sv, k, M), target = 4},\n"
+  "}, M)\n";
 
 int main(int argc, char **argv)
 {

@@ -330,8 +330,9 @@ int dm_linteg_run(lua_State *L)
 
   dm_traj *tr = dm_pushtraj(L, n, li->ls->sys.coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V); /* 5 */
   add_metadata(L, li, tr, r.h);
-  if (r.nsteps / r.every < 100000000L)
-    dm_traj_reserve(tr, (size_t)(r.nsteps / r.every + 2), NULL);  /* best effort */
+  /* best effort; beyond 2^20 samples the storage grows by doubling */
+  dm_traj_reserve(tr, (size_t)(r.nsteps / r.every < (1L << 20) ? r.nsteps / r.every + 2 : 1L << 20),
+                  NULL);
 
   memset(&c, 0, sizeof c);
   c.tr = tr;

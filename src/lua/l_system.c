@@ -340,6 +340,9 @@ static size_t trace_field(lua_State *L, int t, const char *field, const int *arg
   cnt = dm_lua_toexprs(L, -1, what, NULL, 0, &rows, &cols);
   if (scalar && cols != 0)
     luaL_error(L, "dm.system: %s must return one expression, got a list of %d", what, (int)cnt);
+  if (rows != 1 && want == 0)
+    luaL_error(L, "dm.system: %s must return an expression or a flat list of them, got a "
+               "nested list", what);
   if (rows != 1 || (want > 0 && cnt != want))
     luaL_error(L, "dm.system: %s must return a list of %d expressions (one per coordinate), "
                "got %d value%s", what, (int)want, (int)cnt, cnt == 1 ? "" : "s");

@@ -154,6 +154,8 @@ err("force of system 'system' must return a list of 2 expressions %(one per coor
 err("constraint 1 depends on the velocity 'v_x'", "velocity in a constraint",
     {coords = {"x"}, L = L0, constraints = function(q) return q.x - dm.sym("v_x") end})
 err("native must be", "bad native mode", {coords = {"x"}, L = L0, native = "sometimes"})
+err("constraints of system 'system' must return an expression or a flat list of them, got a nested list",
+    "nested constraint list", {coords = {"x"}, L = L0, constraints = function(q) return {{q.x}, {q.x^2}} end})
 T.error_like(function() return sat.nosuch end, "system has no field or method 'nosuch'", "unknown field")
 T.error_like(function() sat:energy({1, 2}, v) end, "energy: q: vector of length 3 expected, got length 2", "wrong size q")
 T.error_like(function() sat:energy({r = 1, theta = 2}, v) end, "energy: q: no value for coordinate 'z'", "missing named coordinate")
