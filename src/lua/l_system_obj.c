@@ -223,7 +223,8 @@ static int expr_field(lua_State *L, dm_lsystem *ls, const char *k)
     {"dLdq", "q"}, {"dLdv", "v"}, {"d2Ldv2", "vv"}, {"d2Ldvdq", "vq"}, {"d2Ldq2", "qq"}
   };
   size_t i;
-  int known = strcmp(k, "L") == 0 || strcmp(k, "force") == 0 || strcmp(k, "constraints") == 0;
+  int known = strcmp(k, "L") == 0 || strcmp(k, "force") == 0 || strcmp(k, "constraints") == 0 ||
+              strcmp(k, "q") == 0 || strcmp(k, "v") == 0 || strcmp(k, "p") == 0;
   for (i = 0; i < sizeof der / sizeof der[0]; i++)
     known |= strcmp(k, der[i].name) == 0;
   if (!known)
@@ -233,6 +234,10 @@ static int expr_field(lua_State *L, dm_lsystem *ls, const char *k)
                       ls->sys.name);
   if (strcmp(k, "L") == 0) {
     dm_lua_pushexpr(L, ls->L);
+  } else if (strcmp(k, "q") == 0 || strcmp(k, "v") == 0) {   /* the traced symbols */
+    dm_lua_pushsymvec(L, k, ls->n, ls->sys.coords, k[0] == 'v' ? "v_%s" : NULL, DM_EXPR_SYM);
+  } else if (strcmp(k, "p") == 0) {
+    dm_lua_pushsymvec(L, "p", ls->npar, ls->sys.params, NULL, DM_EXPR_PARAM);
   } else if (strcmp(k, "force") == 0) {
     if (ls->force)
       push_exprs(L, ls->force, ls->n);
@@ -284,8 +289,8 @@ static int system_index(lua_State *L)
     lua_pushboolean(L, ls->sys.force != NULL);
   else if (!expr_field(L, ls, k))
     return luaL_error(L, "system has no field or method '%s' (fields: name, n, m, coords, "
-                      "params, cyclic, traced, native, separable, mechanical, forced, L, "
-                      "dLdq, dLdv, d2Ldv2, d2Ldvdq, d2Ldq2, force, constraints)", k);
+                      "params, cyclic, traced, native, separable, mechanical, forced, q, v, p, "
+                      "L, dLdq, dLdv, d2Ldv2, d2Ldvdq, d2Ldq2, force, constraints)", k);
   return 1;
 }
 

@@ -35,6 +35,8 @@ T.is(tostring(sat.d2Ldv2[2][2]), "r^2", "sys.d2Ldv2[2][2] = r^2")
 T.is(tostring(sat.dLdq[2]), "0", "sys.dLdq[2] = 0 (cyclic)")
 T.ok(({["2*r*v_theta"] = 1, ["2*v_theta*r"] = 1})[tostring(sat.d2Ldvdq[2][1])], "sys.d2Ldvdq[2][1] = 2 r v_theta")
 T.ok(sat.force == nil and sat.constraints == nil, "no force, no constraints")
+T.is(tostring(sat.L:diff(sat.v.theta)), "r^2*v_theta", "sys.q, sys.v, sys.p are the traced symbols (dL/dv_theta)")
+T.is(tostring(sat.p.J2), "J2", "sys.p.J2 is the parameter")
 
 -- conversions against hand-computed values
 local q, v = {2.385, 0.3, 0.7}, {0.1, 0.45, -0.2}
