@@ -23,11 +23,11 @@ static inline void dm_rprog_run(const dm_rprog *p, const double *in, const doubl
     dm_tape_eval(p->tape, in, par, out, work);
 }
 
-/* Small dense LU with partial pivoting on a row-major N x N matrix (GSL);
- * DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
+/* Small dense LU with partial pivoting on a row-major N x N matrix, in
+ * place; DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
 typedef struct dm_rlu {
   size_t N;
-  void *perm;                      /* gsl_permutation */
+  size_t *perm;                    /* row interchanges */
 } dm_rlu;
 
 struct dm_routh {

@@ -553,9 +553,15 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
       dtheta[i] = 0.0;
     return DM_OK;
   }
-  st = dm_routh_check_inertia(P->red, x0, &P->sing_ref, P->twork, "the initial point", e);
-  if (st == DM_OK && P->gyro)
-    st = eval_node(P, x0, P->a0, NULL, NULL, e);
+  /* continuing from the previous output: x0 was checked and muA(x0) is the
+   * previous muA(x1) */
+  st = cont ? DM_OK : dm_routh_check_inertia(P->red, x0, &P->sing_ref, P->twork, "the initial point", e);
+  if (st == DM_OK && P->gyro) {
+    if (cont)
+      memcpy(P->a0, P->a1, d * sizeof(double));
+    else
+      st = eval_node(P, x0, P->a0, NULL, NULL, e);
+  }
   if (st == DM_OK)
     st = predict(P, h, x0, s0, cont, e);
   if (st == DM_OK && P->m)

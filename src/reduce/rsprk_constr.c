@@ -214,8 +214,10 @@ int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double
     memcpy(P->tin, x1, d * sizeof(double));
     memset(P->tin + d, 0, d * sizeof(double));
     dm_rprog_run(&red->gyro_r, P->tin, red->par, o, P->twork);
-    for (c = 0; c < d; c++)
+    for (c = 0; c < d; c++) {
+      P->a1[c] = o[c];                 /* reused as muA(x0) by the next step */
       P->dp[c] -= o[c] - P->a0[c];
+    }
   }
   if ((st = constr(P, x1, DM_CONSTR_G | DM_CONSTR_DG, S + 1, e)) != DM_OK)
     return st;

@@ -131,8 +131,8 @@ static inline void rs_dsp_constrained(rsys *S, const double *pv)
   S->g[1] = RSUB(RADD(RSQ(S->q[3]), RSQ(S->q[5])), RSQ(S->par[3]));
 }
 
-static inline int rs_reduce(rsys *S, size_t r, const size_t *cyc, const double *mu, dm_routh **red,
-                     dm_err *e)
+static inline int rs_reduce_native(rsys *S, size_t r, const size_t *cyc, const double *mu,
+                                   int native, dm_routh **red, dm_err *e)
 {
   dm_routh_spec sp;
   memset(&sp, 0, sizeof sp);
@@ -150,8 +150,14 @@ static inline int rs_reduce(rsys *S, size_t r, const size_t *cyc, const double *
   sp.r = r;
   sp.cyclic = cyc;
   sp.mu = mu;
-  sp.native = DM_NATIVE_NEVER;
+  sp.native = native;
   return dm_routh_derive(S->c, &sp, red, e);
+}
+
+static inline int rs_reduce(rsys *S, size_t r, const size_t *cyc, const double *mu, dm_routh **red,
+                            dm_err *e)
+{
+  return rs_reduce_native(S, r, cyc, mu, DM_NATIVE_NEVER, red, e);
 }
 
 #endif
