@@ -98,6 +98,11 @@ local fcols = {"theta", "r1", "r2", "phi", "p_theta", "p_r1", "v_theta"}
 T.ok(#full == #tu and maxdiff(full, tu, fcols) <= 1e-12,
      ("reconstructed full trajectory = unreduced Gauss 2 (max diff %.2g)"):format(maxdiff(full, tu, fcols)))
 T.ok(tostring(full):find("double spherical pendulum", 1, true), "the reconstruction is labelled with the full system")
+for _, pair in ipairs{{tc, "classical"}, {td, "dr:gauss"}} do
+  local f = rd:reconstruct(pair[1], {theta = 0.3})
+  T.ok(maxdiff(f, tu, fcols) <= 1e-12, ("reconstruction from the %s run (psi_mu, Lagrangian side) = unreduced (%.2g)")
+       :format(pair[2], maxdiff(f, tu, fcols)))
+end
 do
   local s5 = tr[5]
   local lifted = rd:lift({q = s5.q, p = s5.p}, 0)
