@@ -519,7 +519,6 @@ function M.plot(spec)
       end
       plot_blocks = n
     end})
-  return nil
 end
 
 -- }====
