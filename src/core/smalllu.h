@@ -1,0 +1,49 @@
+/* smalllu.h -- dense LU with partial pivoting for the small Newton systems
+ * of the integrators and the reduction (stage equations, SHAKE, momentum
+ * projections, Legendre maps: n from 1 to a few dozen).
+ *
+ * Why not GSL here.  STYLE.md asks for GSL's linear algebra; small kernels
+ * are the exception when measured.  GSL 2.7's gsl_linalg_LU_decomp is the
+ * blocked (level-3) algorithm: for a 6 x 6 system it goes through views,
+ * cblas_dtrsv/dger/idamax calls and mallocs and frees a pivot vector on
+ * every call.  In the J2 Gauss-2 benchmark (6 x 6 Newton matrix; perf) the
+ * GSL LU and solve were ~35% of a step and malloc/free ~2%.  Factor + solve,
+ * this kernel against GSL (thread CPU time, same machine): n = 3: 60 vs
+ * 269 ns, n = 6: 187 vs 487 ns, n = 9: 515 vs 1104 ns, n = 16: 2.3 vs
+ * 3.3 us; the two are even around n = 24..48 and GSL's blocked code wins
+ * by ~20% from n = 64.  Same pivots and, on this GSL, bitwise the same
+ * factors (tests/c/test_smalllu.c).  Above DM_SMALLLU_NMAX the calls go to
+ * gsl_linalg_LU_decomp / gsl_linalg_LU_svx unchanged.
+ *
+ * Storage.  a is row-major n x n, factored in place: the unit lower factor
+ * below the diagonal, U on and above.  For n <= DM_SMALLLU_NMAX, perm[k] is
+ * the row interchanged with row k at elimination step k (LAPACK's ipiv, 0
+ * based); above, perm is the data of a gsl_permutation.  Only
+ * dm_smalllu_solve reads perm, with the same n, so callers never see the
+ * difference.
+ *
+ * Ownership.  Nothing is allocated for n <= DM_SMALLLU_NMAX: the caller
+ * owns a, perm (room for n) and b.  Above it, GSL >= 2.7 allocates a pivot
+ * vector inside gsl_linalg_LU_decomp (a malloc/free per factorisation).
+ *
+ * Errors.  dm_smalllu_factor returns DM_OK; DM_EDOM (a is left unchanged)
+ * when an entry is NaN or infinite; DM_ESINGULAR when a pivot |U_kk| is not
+ * above 16 n eps max|a_ij| (a relative test, independent of the scale of a;
+ * a is then partly factored and must not be passed to the solve).  No
+ * message is set: callers know what the matrix means.
+ */
+#ifndef DM_SMALLLU_H
+#define DM_SMALLLU_H
+
+#include <stddef.h>
+
+/* Sizes up to this use the kernel in smalllu.c, larger ones GSL. */
+#define DM_SMALLLU_NMAX 32
+
+int dm_smalllu_factor(double *a, size_t n, size_t *perm);
+
+/* Solve A x = b with the factors from dm_smalllu_factor (DM_OK); b is
+ * overwritten by x. */
+void dm_smalllu_solve(const double *lu, size_t n, const size_t *perm, double *b);
+
+#endif
