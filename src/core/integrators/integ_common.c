@@ -1,12 +1,9 @@
-/* integ_common.c -- checked callback evaluation, LU helpers, formatting.
+/* integ_common.c -- checked callback evaluation, formatting.
  * See integ_impl.h. */
 #include <config.h>
 #include "integ_impl.h"
 
-#include <float.h>
-#include <math.h>
 #include <stdio.h>
-#include <gsl/gsl_linalg.h>
 
 /* A callback status (SUNDIALS convention) as a DM status with a message. */
 static int callback_status(int rc, const char *what, const double *q, size_t n, dm_err *e)
@@ -43,32 +40,6 @@ int dm_eval_constr(const dm_system *sys, const double *q, unsigned what,
   return rc == 0 ? DM_OK : callback_status(rc, "constraint evaluation", q, sys->n, e);
 }
 
-int dm_lu_factor(double *a, size_t N, size_t *perm, int *signum)
-{
-  gsl_matrix_view A = gsl_matrix_view_array(a, N, N);
-  gsl_permutation P = {N, perm};
-  double amax = 0.0, umin = HUGE_VAL;
-  size_t i;
-  for (i = 0; i < N * N; i++)
-    amax = fmax(amax, fabs(a[i]));
-  if (!(amax < HUGE_VAL))
-    return DM_EDOM;
-  gsl_linalg_LU_decomp(&A.matrix, &P, signum);
-  for (i = 0; i < N; i++)
-    umin = fmin(umin, fabs(a[i * N + i]));
-  if (!(umin > 16.0 * (double)N * DBL_EPSILON * amax))
-    return DM_ESINGULAR;
-  return DM_OK;
-}
-
-void dm_lu_solve(const double *lu, size_t N, const size_t *perm, double *rhs)
-{
-  gsl_matrix_const_view A = gsl_matrix_const_view_array(lu, N, N);
-  gsl_permutation P = {N, (size_t *)perm};
-  gsl_vector_view x = gsl_vector_view_array(rhs, N);
-  gsl_linalg_LU_svx(&A.matrix, &P, &x.vector);
-}
-
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n)
 {
   size_t i, k = 0;
@@ -81,18 +52,4 @@ const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n)
   if (k < len)
     snprintf(buf + k, len - k, "%s)", n > 6 ? ", ..." : "");
   return buf;
-}
-
-double dm_norm_inf(const double *x, size_t n)
-{
-  double m = 0.0;
-  size_t i;
-  for (i = 0; i < n; i++) {
-    double a = fabs(x[i]);
-    if (a != a)
-      return a;         /* NaN propagates */
-    if (a > m)
-      m = a;
-  }
-  return m;
 }

@@ -100,7 +100,7 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
   dm_lag_out o = {0, w->Lq, w->Lv, w->Lvv, w->Lvq, w->Lqq};
   int mech = (w->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
   double dprev = HUGE_VAL, d = HUGE_VAL;
-  int it, st, sg, stall = 0;
+  int it, st, stall = 0;
   if (!guess)
     memset(v, 0, n * sizeof(double));
   for (it = 0; it < w->maxiter; it++) {
@@ -110,12 +110,12 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
     for (i = 0; i < n; i++)
       w->r[i] = w->Lv[i] - p[i];
     memcpy(w->A, w->Lvv, n * n * sizeof(double));
-    st = dm_lu_factor(w->A, n, w->perm, &sg);
+    st = dm_smalllu_factor(w->A, n, w->perm);
     if (st == DM_ESINGULAR)
       return singular_lvv(w->sys, q, v, e);
     if (st != DM_OK)
       return dm_err_set(e, DM_EDOM, "non-finite d2L/dv2 in the velocity solve");
-    dm_lu_solve(w->A, n, w->perm, w->r);
+    dm_smalllu_solve(w->A, n, w->perm, w->r);
     for (i = 0; i < n; i++)
       v[i] -= w->r[i];
     ls = dm_norm_inf(w->Lvv, n * n);
@@ -164,7 +164,7 @@ int dm_legendre_field_jac(dm_legendre_ws *w, const double *q, const double *p,
   dm_lag_out o = {0, w->Lq, w->Lv, w->Lvv, w->Lvq, w->Lqq};
   const double *v = w->vguess;
   double *X = w->T;     /* n x 2n: Lvv^{-1} [-Lvq | I] */
-  int st, sg;
+  int st;
   if ((st = dm_legendre_velocity(w, q, p, w->vguess, w->have_guess, e)) != DM_OK)
     return st;
   w->have_guess = 1;
@@ -179,12 +179,12 @@ int dm_legendre_field_jac(dm_legendre_ws *w, const double *q, const double *p,
     memset(w->Fv, 0, n * n * sizeof(double));
   }
   memcpy(w->A, w->Lvv, n * n * sizeof(double));
-  if (dm_lu_factor(w->A, n, w->perm, &sg) != DM_OK)
+  if (dm_smalllu_factor(w->A, n, w->perm) != DM_OK)
     return singular_lvv(w->sys, q, v, e);
   for (j = 0; j < N2; j++) {
     for (i = 0; i < n; i++)
       w->r[i] = j < n ? -w->Lvq[i * n + j] : (i == j - n);
-    dm_lu_solve(w->A, n, w->perm, w->r);
+    dm_smalllu_solve(w->A, n, w->perm, w->r);
     for (i = 0; i < n; i++)
       X[i * N2 + j] = w->r[i];
   }

@@ -186,7 +186,7 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
   dm_lag_out o = {0, P->Lq, P->Lv, P->Lvv, P->Lvq, P->Lqq};   /* stage-1 buffers as scratch */
   int mech = (P->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
   double d = HUGE_VAL, dprev = HUGE_VAL;
-  int it, st, sg, stall = 0;
+  int it, st, stall = 0;
   memcpy(v, vguess, n * sizeof(double));
   memset(mu, 0, m * sizeof(double));
   for (it = 0; it < P->maxiter; it++) {
@@ -211,12 +211,12 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
         acc += G1[a * n + c] * v[c];
       P->R[n + a] = acc;
     }
-    st = dm_lu_factor(P->Jm, N, P->perm, &sg);
+    st = dm_smalllu_factor(P->Jm, N, P->perm);
     if (st != DM_OK)
       return dm_err_set(e, st == DM_ESINGULAR ? DM_ESINGULAR : DM_EDOM,
                         "momentum projection onto the constraint manifold: singular system "
                         "(dependent constraint gradients or singular d2L/dv2)");
-    dm_lu_solve(P->Jm, N, P->perm, P->R);
+    dm_smalllu_solve(P->Jm, N, P->perm, P->R);
     for (i = 0; i < N; i++)
       y[i] -= P->R[i];
     ps = dm_norm_inf(p, n);

@@ -276,11 +276,10 @@ static double update_norm(const dm_prk *P, int mode, double h, const double *p0)
 int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
 {
   size_t n = P->n, i;
-  int sg;
   char bq[160], bv[160];
   for (i = 0; i < P->s; i++) {
     memcpy(P->Jm, P->Lvv + i * P->nn, P->nn * sizeof(double));
-    if (dm_lu_factor(P->Jm, n, P->perm, &sg) != DM_OK)
+    if (dm_smalllu_factor(P->Jm, n, P->perm) != DM_OK)
       return dm_err_set(e, DM_ESINGULAR,
                         "d2L/dv2 is singular at stage %zu (q = %s, v = %s): the Lagrangian of "
                         "'%s' is not regular (its Hessian in the velocities must be invertible)",
@@ -298,7 +297,7 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
 {
   size_t N = nunk(P, mode), i;
   double d = HUGE_VAL, dbest = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
-  int it, st, sg, stall = 0, ok = 0, jac = 1, njac = 0;
+  int it, st, stall = 0, ok = 0, jac = 1, njac = 0;
   for (it = 1; it <= P->maxiter; it++) {
     if ((st = assemble(P, mode, h, q0, p0, q1t, jac, e)) != DM_OK)
       return st;
@@ -308,13 +307,13 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
                         h, it);
     if (jac) {
       njac++;
-      st = dm_lu_factor(P->Jm, N, P->perm, &sg);
+      st = dm_smalllu_factor(P->Jm, N, P->perm);
       if (st == DM_ESINGULAR)
         return dm_prk_singular(P, "stage equations", h, e);
       if (st != DM_OK)
         return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
     }
-    dm_lu_solve(P->Jm, N, P->perm, P->R);
+    dm_smalllu_solve(P->Jm, N, P->perm, P->R);
     for (i = 0; i < N; i++)
       P->X[i] -= P->R[i];
     d = update_norm(P, mode, h, p0);
@@ -475,14 +474,14 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
 {
   size_t n = P->n, s = P->s, sn = P->sn, nn = P->nn, N2 = 2 * n, i, j, k, a, c, x;
   const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
-  int st, sg;
+  int st;
   if (P->m)
     return dm_err_set(e, DM_EUNSUP, "the step Jacobian is not available for constrained systems");
   if ((st = dm_prk_step(P, h, q0, p0, DPhi, DPhi + n, stt, e)) != DM_OK)
     return st;
   if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, NULL, 1, e)) != DM_OK)
     return st;
-  if (dm_lu_factor(P->Jm, sn, P->perm, &sg) != DM_OK)
+  if (dm_smalllu_factor(P->Jm, sn, P->perm) != DM_OK)
     return dm_prk_singular(P, "stage equations", h, e);
   for (c = 0; c < N2; c++) {
     double *dV = P->rhs + c * sn;
@@ -498,7 +497,7 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
         }
         dV[i * n + a] = -v;
       }
-    dm_lu_solve(P->Jm, sn, P->perm, dV);
+    dm_smalllu_solve(P->Jm, sn, P->perm, dV);
     /* dQ_j = e_c (q part) + h sum_k a_jk dV_k, stored in Q as scratch */
     for (j = 0; j < s; j++)
       for (a = 0; a < n; a++) {

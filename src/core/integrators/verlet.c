@@ -78,7 +78,7 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
   size_t n = P->n, m = P->m, a, b, c;
   double *u = P->X, *mu = P->X + 2 * n, *qq = P->tmp, *gq = P->g, *Gq = P->G, *ph = P->dp;
   double d = HUGE_VAL, dprev = HUGE_VAL;
-  int it, st, sg, stall = 0;
+  int it, st, stall = 0;
   for (it = 1; it <= P->maxiter; it++) {
     for (c = 0; c < n; c++) {
       double acc = base[c];
@@ -105,10 +105,10 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
       P->R[a] = gq[a] / h;
     if (!isfinite(dm_norm_inf(P->R, m)))
       return dm_err_set(e, DM_EDOM, "SHAKE: non-finite constraint residual (h = %g)", h);
-    if ((st = dm_lu_factor(P->Jm, m, P->perm, &sg)) != DM_OK)
+    if ((st = dm_smalllu_factor(P->Jm, m, P->perm)) != DM_OK)
       return dm_err_set(e, DM_ESINGULAR, "SHAKE: singular constraint matrix G(q1) M^-1 G(q0)^T "
                         "(h = %g too large, or dependent constraints)", h);
-    dm_lu_solve(P->Jm, m, P->perm, P->R);
+    dm_smalllu_solve(P->Jm, m, P->perm, P->R);
     for (a = 0; a < m; a++)
       mu[a] -= P->R[a];
     d = dm_norm_inf(P->R, m) / fmax(fmax(dm_norm_inf(mu, m), ms), DBL_MIN);
