@@ -7,6 +7,7 @@
 #include <config.h>
 #include "routh_impl.h"
 #include "core/lagrangian.h"
+#include "core/smalllu.h"
 
 #include <float.h>
 #include <math.h>
@@ -480,11 +481,9 @@ void dm_routh_sym_eig(const double *I, size_t r, double *lmin, double *lmax)
   *lmax = hi;
 }
 
-/* LU with partial pivoting, in place, row-major, for the small dense Newton
- * systems of the reduced integrators (N <= a few dozen).  GSL's LU goes
- * through BLAS-1 calls and views whose overhead dominates at these sizes
- * (measured: a third of an RSPRK step); the core PRK engine uses the same
- * approach (src/core/integrators/integ_common.c). */
+/* The small dense Newton systems of the reduced integrators use the core's
+ * LU kernel (src/core/smalllu.h: partial pivoting, in place, row-major,
+ * no allocation); dm_rlu only owns the pivot array. */
 int dm_rlu_init(dm_rlu *lu, size_t N)
 {
   lu->N = N;
@@ -500,63 +499,14 @@ void dm_rlu_free(dm_rlu *lu)
 
 int dm_rlu_factor(dm_rlu *lu, double *a, size_t N)
 {
-  size_t *perm = lu->perm, i, j, k;
-  double amax = dm_rnorm_inf(a, N * N), tiny;
   if (N != lu->N)
     return DM_EINVAL;
-  if (!isfinite(amax))
-    return DM_EDOM;
-  tiny = 16.0 * (double)N * DBL_EPSILON * amax;
-  for (k = 0; k < N; k++) {
-    size_t p = k;
-    double best = fabs(a[k * N + k]), piv;
-    for (i = k + 1; i < N; i++)
-      if (fabs(a[i * N + k]) > best) {
-        best = fabs(a[i * N + k]);
-        p = i;
-      }
-    perm[k] = p;
-    if (!(best > tiny))
-      return DM_ESINGULAR;
-    if (p != k)
-      for (j = 0; j < N; j++) {
-        double t = a[k * N + j];
-        a[k * N + j] = a[p * N + j];
-        a[p * N + j] = t;
-      }
-    piv = 1.0 / a[k * N + k];
-    for (i = k + 1; i < N; i++) {
-      double f = a[i * N + k] *= piv;
-      if (f != 0.0)
-        for (j = k + 1; j < N; j++)
-          a[i * N + j] -= f * a[k * N + j];
-    }
-  }
-  return DM_OK;
+  return dm_smalllu_factor(a, N, lu->perm);
 }
 
 void dm_rlu_solve(const dm_rlu *lu, const double *a, size_t N, double *b)
 {
-  const size_t *perm = lu->perm;
-  size_t i, j, k;
-  for (k = 0; k < N; k++)
-    if (perm[k] != k) {
-      double t = b[k];
-      b[k] = b[perm[k]];
-      b[perm[k]] = t;
-    }
-  for (i = 1; i < N; i++) {
-    double acc = b[i];
-    for (j = 0; j < i; j++)
-      acc -= a[i * N + j] * b[j];
-    b[i] = acc;
-  }
-  for (i = N; i-- > 0;) {
-    double acc = b[i];
-    for (j = i + 1; j < N; j++)
-      acc -= a[i * N + j] * b[j];
-    b[i] = acc / a[i * N + i];
-  }
+  dm_smalllu_solve(a, N, lu->perm, b);
 }
 
 /* max |x_i|; NaN when some x_i is NaN or infinite */

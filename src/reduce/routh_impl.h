@@ -24,7 +24,9 @@ static inline void dm_rprog_run(const dm_rprog *p, const double *in, const doubl
 }
 
 /* Small dense LU with partial pivoting on a row-major N x N matrix, in
- * place; DM_ESINGULAR when a pivot is below 16 N eps max|a|. */
+ * place (dm_smalllu_factor of src/core/smalllu.h; this struct holds the
+ * pivots); DM_ESINGULAR when a pivot is below 16 N eps max|a|, DM_EDOM for a
+ * non-finite entry, DM_EINVAL when N differs from the size given to init. */
 typedef struct dm_rlu {
   size_t N;
   size_t *perm;                    /* row interchanges */
