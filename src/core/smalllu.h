@@ -11,12 +11,14 @@
  * this kernel against GSL (thread CPU time, same machine): n = 3: 60 vs
  * 269 ns, n = 6: 187 vs 487 ns, n = 9: 515 vs 1104 ns, n = 16: 2.3 vs
  * 3.3 us; the two are even around n = 24..48 and GSL's blocked code wins
- * by ~20% from n = 64.  Same pivots and, on this GSL, bitwise the same
- * factors (tests/c/test_smalllu.c).  Above DM_SMALLLU_NMAX the calls go to
+ * by ~20% from n = 64.  Same pivots as GSL, and L and U equal to GSL's
+ * to round-off (tests/c/test_smalllu.c).  Above DM_SMALLLU_NMAX the calls go to
  * gsl_linalg_LU_decomp / gsl_linalg_LU_svx unchanged.
  *
  * Storage.  a is row-major n x n, factored in place: the unit lower factor
- * below the diagonal, U on and above.  For n <= DM_SMALLLU_NMAX, perm[k] is
+ * below the diagonal, U above it; on the diagonal 1/U_kk for n <=
+ * DM_SMALLLU_NMAX (the solve then multiplies), U_kk above (GSL's layout).
+ * Treat the factors as opaque.  For n <= DM_SMALLLU_NMAX, perm[k] is
  * the row interchanged with row k at elimination step k (LAPACK's ipiv, 0
  * based); above, perm is the data of a gsl_permutation.  Only
  * dm_smalllu_solve reads perm, with the same n, so callers never see the
