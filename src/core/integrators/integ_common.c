@@ -5,8 +5,9 @@
 
 #include <stdio.h>
 
-/* A callback status (SUNDIALS convention) as a DM status with a message. */
-static int callback_status(int rc, const char *what, const double *q, size_t n, dm_err *e)
+/* A failed callback status (SUNDIALS convention) as a DM status with a
+ * message; the evaluation wrappers in integ_impl.h call it only when rc != 0. */
+int dm_eval_fail(int rc, const char *what, const double *q, size_t n, dm_err *e)
 {
   char buf[160];
   if (rc == 0)
@@ -16,28 +17,6 @@ static int callback_status(int rc, const char *what, const double *q, size_t n, 
                       what, dm_fmt_vec(buf, sizeof buf, q, n), rc);
   return dm_err_set(e, DM_ECALLBACK, "%s failed at q = %s (callback status %d)",
                     what, dm_fmt_vec(buf, sizeof buf, q, n), rc);
-}
-
-int dm_eval_lag(const dm_system *sys, const double *q, const double *v,
-                unsigned what, dm_lag_out *out, void *work, dm_err *e)
-{
-  int rc = sys->lagrangian(sys->data, q, v, sys->par, what, out, work);
-  return rc == 0 ? DM_OK : callback_status(rc, "Lagrangian evaluation", q, sys->n, e);
-}
-
-int dm_eval_force(const dm_system *sys, const double *q, const double *v,
-                  unsigned what, double *F, double *Fq, double *Fv, void *work,
-                  dm_err *e)
-{
-  int rc = sys->force(sys->data, q, v, sys->par, what, F, Fq, Fv, work);
-  return rc == 0 ? DM_OK : callback_status(rc, "force evaluation", q, sys->n, e);
-}
-
-int dm_eval_constr(const dm_system *sys, const double *q, unsigned what,
-                   double *g, double *G, double *H, void *work, dm_err *e)
-{
-  int rc = sys->constraints(sys->data, q, sys->par, what, g, G, H, work);
-  return rc == 0 ? DM_OK : callback_status(rc, "constraint evaluation", q, sys->n, e);
 }
 
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n)

@@ -36,16 +36,47 @@ static inline int dm_newton_stalled(double d, double *best, int *stall)
 
 /* {==== checked evaluation ============================================== */
 
-int dm_eval_lag(const dm_system *sys, const double *q, const double *v,
-                unsigned what, dm_lag_out *out, void *work, dm_err *e);
-int dm_eval_force(const dm_system *sys, const double *q, const double *v,
-                  unsigned what, double *F, double *Fq, double *Fv, void *work,
-                  dm_err *e);
-int dm_eval_constr(const dm_system *sys, const double *q, unsigned what,
-                   double *g, double *G, double *H, void *work, dm_err *e);
+/* The callbacks, with a failing status turned into DM_EDOM / DM_ECALLBACK
+ * and a message naming q.  Inline: they run several times per Newton
+ * iteration; the message is formatted out of line (dm_eval_fail). */
+int dm_eval_fail(int rc, const char *what, const double *q, size_t n, dm_err *e);
+
+static inline int dm_eval_lag(const dm_system *sys, const double *q, const double *v,
+                              unsigned what, dm_lag_out *out, void *work, dm_err *e)
+{
+  int rc = sys->lagrangian(sys->data, q, v, sys->par, what, out, work);
+  return rc == 0 ? DM_OK : dm_eval_fail(rc, "Lagrangian evaluation", q, sys->n, e);
+}
+
+static inline int dm_eval_force(const dm_system *sys, const double *q, const double *v,
+                                unsigned what, double *F, double *Fq, double *Fv, void *work,
+                                dm_err *e)
+{
+  int rc = sys->force(sys->data, q, v, sys->par, what, F, Fq, Fv, work);
+  return rc == 0 ? DM_OK : dm_eval_fail(rc, "force evaluation", q, sys->n, e);
+}
+
+static inline int dm_eval_constr(const dm_system *sys, const double *q, unsigned what,
+                                 double *g, double *G, double *H, void *work, dm_err *e)
+{
+  int rc = sys->constraints(sys->data, q, sys->par, what, g, G, H, work);
+  return rc == 0 ? DM_OK : dm_eval_fail(rc, "constraint evaluation", q, sys->n, e);
+}
 
 /* "(x1, x2, ...)" into buf (at most 6 entries). */
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n);
+
+/* max(a, b), NaN when either is NaN (fmax drops NaNs and is a libm call
+ * at -O2). */
+static inline double dm_max2(double a, double b)
+{
+  return a > b || a != a ? a : b;
+}
+
+static inline double dm_max3(double a, double b, double c)
+{
+  return dm_max2(dm_max2(a, b), c);
+}
 
 /* max |x_i|, NaN when some x_i is NaN (+-Inf gives Inf).  Inline and
  * without a branch per entry: it runs several times per Newton iteration on

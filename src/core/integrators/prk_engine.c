@@ -176,7 +176,20 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
   if (st != DM_OK)
     return st;
   P->Lval[i] = o.L;
-  if (P->forced) {
+  if (!P->forced) {
+    /* F, Fq, Fv stay zero: W = Lq, D = Lqq, Bm = Lvq^T without the additions */
+    memcpy(P->W + i * n, P->Lq + i * n, n * sizeof(double));
+    if (jac) {
+      const double *Lvq = P->Lvq + i * nn;
+      double *Bm = P->Bm + i * nn;
+      memcpy(P->D + i * nn, P->Lqq + i * nn, nn * sizeof(double));
+      for (a = 0; a < n; a++)
+        for (b = 0; b < n; b++)
+          Bm[a * n + b] = Lvq[b * n + a];
+    }
+    return DM_OK;
+  }
+  {
     unsigned fw = DM_FORCE_F | (jac ? (DM_FORCE_Q | DM_FORCE_V) : 0u);
     st = dm_eval_force(P->sys, Qi, Vi, fw, P->F + i * n, P->Fq + i * nn, P->Fv + i * nn,
                        P->work, e);
@@ -194,55 +207,82 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
   return DM_OK;
 }
 
+/* The stage-velocity block of the Newton matrix (row stride N):
+ *   J_ik = d_ik Lvv_i + h a_ik Lvq_i - h at_ik Bm_k - sum_j (h^2 at_ij a_jk) D_j,
+ * each entry accumulated in a register (restrict: the arrays never alias). */
+static void newton_matrix(dm_prk *P, double h, size_t N)
+{
+  const size_t n = P->n, s = P->s, nn = P->nn;
+  const double *restrict A = P->tab->a, *restrict At = P->tab->at;
+  const double *restrict Lvv = P->Lvv, *restrict Lvq = P->Lvq, *restrict Bm = P->Bm;
+  const double *restrict D = P->D;
+  double *restrict Jm = P->Jm, cj[DM_TABLEAU_SMAX];
+  size_t i, j, k, a, c;
+  for (i = 0; i < s; i++)
+    for (k = 0; k < s; k++) {
+      const double hak = h * A[i * s + k], hatk = h * At[i * s + k];
+      const double *Lvqi = Lvq + i * nn, *Bmk = Bm + k * nn, *Lvvi = Lvv + i * nn;
+      for (j = 0; j < s; j++)
+        cj[j] = h * h * At[i * s + j] * A[j * s + k];
+      for (a = 0; a < n; a++) {
+        double *Jr = Jm + (i * n + a) * N + k * n;
+        for (c = 0; c < n; c++) {
+          double v = hak * Lvqi[a * n + c] - hatk * Bmk[a * n + c];
+          if (i == k)
+            v += Lvvi[a * n + c];
+          for (j = 0; j < s; j++)
+            v -= cj[j] * D[j * nn + a * n + c];
+          Jr[c] = v;
+        }
+      }
+    }
+}
+
 /* Residual (and Newton matrix when jac) of the stage equations at X. */
 static int assemble(dm_prk *P, int mode, double h, const double *q0, const double *p0,
                     const double *q1t, int jac, dm_err *e)
 {
-  size_t n = P->n, s = P->s, nn = P->nn, sn = P->sn, N = nunk(P, mode);
+  const size_t n = P->n, s = P->s, sn = P->sn, N = nunk(P, mode);
   const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
   const double *V = P->X, *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
-  size_t i, j, k, a, c;
+  size_t i, j, a;
   int st;
-  for (i = 0; i < s; i++)
-    for (a = 0; a < n; a++) {
-      double acc = 0.0;
-      for (j = 0; j < s; j++)
-        acc += A[i * s + j] * V[j * n + a];
-      P->Q[i * n + a] = q0[a] + h * acc;
-    }
+  {
+    double *restrict Q = P->Q;   /* restrict in these blocks only: the */
+    for (i = 0; i < s; i++)      /* stage evaluation reads and writes P */
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += A[i * s + j] * V[j * n + a];
+        Q[i * n + a] = q0[a] + h * acc;
+      }
+  }
   for (i = 0; i < s; i++)
     if ((st = dm_prk_eval_stage(P, i, jac, mode == DM_PRK_DLEG, e)) != DM_OK)
       return st;
-  for (i = 0; i < s; i++)
-    for (a = 0; a < n; a++) {
-      double acc = 0.0;
-      for (j = 0; j < s; j++)
-        acc += At[i * s + j] * P->W[j * n + a];
-      P->R[i * n + a] = P->Lv[i * n + a] - pp[a] - h * acc;
-    }
-  if (mode == DM_PRK_DLEG)
-    for (a = 0; a < n; a++) {
-      double acc = 0.0;
-      for (j = 0; j < s; j++)
-        acc += b[j] * V[j * n + a];
-      P->R[sn + a] = acc - (q1t[a] - q0[a]) / h;
-    }
-  if (jac) {
-    memset(P->Jm, 0, N * N * sizeof(double));
+  {
+    const double *restrict W = P->W, *restrict Lv = P->Lv;
+    double *restrict R = P->R;
     for (i = 0; i < s; i++)
-      for (k = 0; k < s; k++) {
-        double hak = h * A[i * s + k], hatk = h * At[i * s + k];
-        double *Jb = P->Jm + (i * n) * N + k * n;
-        for (a = 0; a < n; a++)
-          for (c = 0; c < n; c++) {
-            double v = hak * P->Lvq[i * nn + a * n + c] - hatk * P->Bm[k * nn + a * n + c];
-            if (i == k)
-              v += P->Lvv[i * nn + a * n + c];
-            for (j = 0; j < s; j++)
-              v -= h * h * At[i * s + j] * A[j * s + k] * P->D[j * nn + a * n + c];
-            Jb[a * N + c] = v;
-          }
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += At[i * s + j] * W[j * n + a];
+        R[i * n + a] = Lv[i * n + a] - pp[a] - h * acc;
       }
+    if (mode == DM_PRK_DLEG)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += b[j] * V[j * n + a];
+        R[sn + a] = acc - (q1t[a] - q0[a]) / h;
+      }
+  }
+  if (jac) {
+    if (N > sn)
+      memset(P->Jm, 0, N * N * sizeof(double));
+    newton_matrix(P, h, N);
+    P->lvv_norm = dm_norm_inf(P->Lvv, s * P->nn);
     if (mode == DM_PRK_DLEG)
       for (i = 0; i < s; i++)
         for (a = 0; a < n; a++) {
@@ -263,12 +303,12 @@ static double update_norm(const dm_prk *P, int mode, double h, const double *p0)
   size_t sn = P->sn, N = nunk(P, mode);
   const double *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
   double ms = dm_norm_inf(pp, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
-  double lv = dm_norm_inf(P->Lvv, P->s * P->nn);
-  double vs = fmax(fmax(dm_norm_inf(P->X, sn), lv > 0 ? ms / lv : 0.0), DBL_MIN);
+  double lv = P->lvv_norm;      /* Lvv changes only with the Jacobian */
+  double vs = dm_max3(dm_norm_inf(P->X, sn), lv > 0 ? ms / lv : 0.0, DBL_MIN);
   double d = dm_norm_inf(P->R, sn) / vs;
   if (N > sn) {
-    double xs = fmax(fmax(dm_norm_inf(P->X + sn, N - sn), ms), DBL_MIN);
-    d = fmax(d, dm_norm_inf(P->R + sn, N - sn) / xs);
+    double xs = dm_max3(dm_norm_inf(P->X + sn, N - sn), ms, DBL_MIN);
+    d = dm_max2(d, dm_norm_inf(P->R + sn, N - sn) / xs);
   }
   return d;
 }

@@ -23,6 +23,7 @@ struct dm_prk {
   int maxiter;
   int simplified;              /* reuse the factored Jacobian while converging fast */
   int njac;                    /* Jacobian factorisations in the last solve */
+  double lvv_norm;             /* max |Lvv| over the stages, set with the Jacobian */
   /* constraints: multipliers at the stages K (interior stages of a Lobatto
    * type tableau), plus mu0 on p0 and g(q1) = 0 (see prk_constrained.c) */
   size_t nK, K[DM_TABLEAU_SMAX];
