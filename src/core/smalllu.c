@@ -90,9 +90,9 @@ static void solve_small(const double *restrict a, size_t n, const size_t *restri
       acc -= a[i * n + j] * b[j];
     b[i] = acc;
   }
-  for (i = n; i-- > 0;) {
+  for (i = n; i-- > 0;) {        /* b[i + 1], the newest, is used last */
     double acc = b[i];
-    for (j = i + 1; j < n; j++)
+    for (j = n - 1; j > i; j--)
       acc -= a[i * n + j] * b[j];
     b[i] = acc * a[i * n + i];
   }

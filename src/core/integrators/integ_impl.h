@@ -14,6 +14,8 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_permutation.h>
 #include "integrator.h"
@@ -65,6 +67,30 @@ static inline int dm_eval_constr(const dm_system *sys, const double *q, unsigned
 
 /* "(x1, x2, ...)" into buf (at most 6 entries). */
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n);
+
+/* y = x, n doubles, as an inline loop: the copies of a step are a few
+ * doubles each and a memcpy call costs more than the copy.  (No restrict:
+ * GCC would turn the loop back into a memmove call.) */
+static inline void dm_vcopy(double *y, const double *x, size_t n)
+{
+  size_t i;
+  for (i = 0; i < n; i++)
+    y[i] = x[i];
+}
+
+/* x and y bitwise equal (memcmp semantics, inline). */
+static inline int dm_same(const double *x, const double *y, size_t n)
+{
+  size_t i;
+  for (i = 0; i < n; i++) {
+    uint64_t a, b;
+    memcpy(&a, x + i, sizeof a);
+    memcpy(&b, y + i, sizeof b);
+    if (a != b)
+      return 0;
+  }
+  return 1;
+}
 
 /* max(a, b), NaN when either is NaN (fmax drops NaNs and is a libm call
  * at -O2). */

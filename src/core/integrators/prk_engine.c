@@ -178,11 +178,11 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
   P->Lval[i] = o.L;
   if (!P->forced) {
     /* F, Fq, Fv stay zero: W = Lq, D = Lqq, Bm = Lvq^T without the additions */
-    memcpy(P->W + i * n, P->Lq + i * n, n * sizeof(double));
+    dm_vcopy(P->W + i * n, P->Lq + i * n, n);
     if (jac) {
       const double *Lvq = P->Lvq + i * nn;
       double *Bm = P->Bm + i * nn;
-      memcpy(P->D + i * nn, P->Lqq + i * nn, nn * sizeof(double));
+      dm_vcopy(P->D + i * nn, P->Lqq + i * nn, nn);
       for (a = 0; a < n; a++)
         for (b = 0; b < n; b++)
           Bm[a * n + b] = Lvq[b * n + a];
@@ -450,9 +450,8 @@ int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
 {
   size_t n = P->n, s = P->s, sn = P->sn, i, a;
   const double *b = P->tab->b;
-  int mode = P->m ? DM_PRK_CSTEP : DM_PRK_STEP, st;
-  int cont = P->hist && memcmp(q0, P->hq1, n * sizeof(double)) == 0
-             && memcmp(p0, P->hp1, n * sizeof(double)) == 0;
+  int mode = P->m ? DM_PRK_CSTEP : DM_PRK_STEP, st, bad = 0;
+  int cont = P->hist && dm_same(q0, P->hq1, n) && dm_same(p0, P->hp1, n);
   if (!cont) {
     memset(P->cq, 0, n * sizeof(double));
     memset(P->cp, 0, n * sizeof(double));
@@ -474,36 +473,46 @@ int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
     if (st == DM_OK && P->m) {
       st = dm_prk_constr_finish(P, h, q0, p0, P->q1w, P->p1w, e);
     } else if (st == DM_OK) {
+      /* q1 = q0 + h sum b_i V_i, p1 = p0 + h sum b_i W_i, Kahan-compensated
+       * (the arithmetic of dm_prk_kahan, in one pass) */
+      const double *X = P->X, *W = P->W;
+      double *cq = P->cq, *cp = P->cp, *q1w = P->q1w, *p1w = P->p1w;
       for (a = 0; a < n; a++) {
-        double sq = 0.0, sp = 0.0;
+        double sq = 0.0, sp = 0.0, y, t;
         for (i = 0; i < s; i++) {
-          sq += b[i] * P->X[i * n + a];
-          sp += b[i] * P->W[i * n + a];
+          sq += b[i] * X[i * n + a];
+          sp += b[i] * W[i * n + a];
         }
-        P->dq[a] = h * sq;
-        P->dp[a] = h * sp;
+        y = h * sq - cq[a];
+        t = q0[a] + y;
+        cq[a] = (t - q0[a]) - y;
+        q1w[a] = t;
+        y = h * sp - cp[a];
+        t = p0[a] + y;
+        cp[a] = (t - p0[a]) - y;
+        p1w[a] = t;
       }
-      dm_prk_kahan(n, q0, P->dq, P->cq, P->q1w);
-      dm_prk_kahan(n, p0, P->dp, P->cp, P->p1w);
     }
   }
-  for (a = 0; a < n && st == DM_OK; a++)
-    if (!isfinite(P->q1w[a]) || !isfinite(P->p1w[a]))
-      st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
+  for (a = 0; a < n; a++)
+    bad |= !isfinite(P->q1w[a]) | !isfinite(P->p1w[a]);
+  if (st == DM_OK && bad)
+    st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
   if (st != DM_OK) {
     P->hist = 0;
     P->svf_valid = 0;
     return st;
   }
-  memcpy(P->hV, P->X, sn * sizeof(double));
-  if (P->Nmax > sn)
-    memcpy(P->hx, P->X + sn, (P->Nmax - sn) * sizeof(double));
-  memcpy(P->hq1, P->q1w, n * sizeof(double));
-  memcpy(P->hp1, P->p1w, n * sizeof(double));
+  /* history: the predictor's stages (and multipliers), continuation test */
+  dm_vcopy(P->hV, P->X, sn);
+  if (P->m)
+    dm_vcopy(P->hx, P->X + sn, nunk(P, DM_PRK_CSTEP) - sn);
+  dm_vcopy(P->hq1, P->q1w, n);
+  dm_vcopy(P->hp1, P->p1w, n);
   P->hist_h = h;
   P->hist = 1;
-  memcpy(q1, P->q1w, n * sizeof(double));
-  memcpy(p1, P->p1w, n * sizeof(double));
+  dm_vcopy(q1, P->q1w, n);
+  dm_vcopy(p1, P->p1w, n);
   if (stt)
     stt->steps++;
   return DM_OK;
