@@ -68,6 +68,7 @@ void dm_expr_ctx_free(dm_expr_ctx *ctx)
   free(ctx->aux);
   free(ctx->stack);
   free(ctx->list);
+  dm_expr__norm_free(ctx);
   free(ctx);
 }
 
@@ -79,22 +80,8 @@ size_t dm_expr_ctx_size(const dm_expr_ctx *ctx) { return ctx->n; }
  * hash-consing
  * =================================================================== */
 
-static uint64_t mix64(uint64_t h)
-{
-  h ^= h >> 33;
-  h *= 0xff51afd7ed558ccdULL;
-  h ^= h >> 33;
-  h *= 0xc4ceb9fe1a85ec53ULL;
-  h ^= h >> 33;
-  return h;
-}
-
-static uint64_t dbits(double x)
-{
-  uint64_t u;
-  memcpy(&u, &x, sizeof u);
-  return u;
-}
+#define mix64 dm_expr__mix64
+#define dbits dm_expr__dbits
 
 static uint64_t node_hash(const dm_expr_ctx *ctx, int op, int32_t a,
                           int32_t b, int32_t c)
@@ -160,7 +147,7 @@ static dm_expr cons(dm_expr_ctx *ctx, int op, int32_t a, int32_t b, int32_t c)
   }
   dm_node *nd = &ctx->node[ctx->n];
   nd->op = (uint8_t)op;
-  nd->pad = 0;
+  nd->len = 0;
   nd->a = a;
   nd->b = b;
   nd->c = c;
@@ -225,6 +212,11 @@ dm_expr dm_expr_const(dm_expr_ctx *ctx, double x)
   }
   ctx->cval[ctx->ncval] = x;  /* tentative: kept only if the node is new */
   return cons(ctx, DM_EXPR_CONST, (int32_t)ctx->ncval, -1, -1);
+}
+
+dm_expr dm_expr__k(dm_expr_ctx *ctx, double x)
+{
+  return dm_expr_const(ctx, x);
 }
 
 /* {==================================================================
@@ -331,292 +323,11 @@ static int check2(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
   return 1;
 }
 
-/* e = c * t with c a constant: returns c and sets *t (c = 1, t = e when e
- * has no constant factor). */
-static double split_coef(const dm_expr_ctx *ctx, dm_expr e, dm_expr *t)
-{
-  const dm_node *nd = &ctx->node[e];
-  double c;
-  if (nd->op == DM_EXPR_MUL && isc(ctx, nd->a, &c)) {
-    *t = nd->b;
-    return c;
-  }
-  if (nd->op == DM_EXPR_NEG) {
-    *t = nd->a;
-    return -1.0;
-  }
-  *t = e;
-  return 1.0;
-}
-
-/* e = t^n: returns n and sets *t (n = 1 for anything but POWI). */
-static int split_pow(const dm_expr_ctx *ctx, dm_expr e, dm_expr *t)
-{
-  const dm_node *nd = &ctx->node[e];
-  if (nd->op == DM_EXPR_POWI) {
-    *t = nd->a;
-    return nd->b;
-  }
-  *t = e;
-  return 1;
-}
-
-/* a = f*x and b = f*y with a common non-constant factor f (products are
- * binary, so f is an operand of each): returns f and sets *x, *y. */
-static dm_expr common_factor(const dm_expr_ctx *ctx, dm_expr a, dm_expr b,
-                             dm_expr *x, dm_expr *y)
-{
-  const dm_node *na = &ctx->node[a], *nb = &ctx->node[b];
-  if (na->op != DM_EXPR_MUL || nb->op != DM_EXPR_MUL)
-    return DM_EXPR_NONE;
-  double c;
-  int32_t ao[2] = { na->a, na->b }, bo[2] = { nb->a, nb->b };
-  for (int i = 0; i < 2; i++)
-    for (int j = 0; j < 2; j++)
-      if (ao[i] == bo[j] && !isc(ctx, ao[i], &c)) {
-        *x = ao[1 - i];
-        *y = bo[1 - j];
-        return ao[i];
-      }
-  return DM_EXPR_NONE;
-}
-
-/* A node that prints with a leading minus: negative constant, -x, c*x with
- * c < 0, c/x with c < 0. */
-static int negative_looking(const dm_expr_ctx *ctx, dm_expr e)
-{
-  const dm_node *nd = &ctx->node[e];
-  double c;
-  if (nd->op == DM_EXPR_NEG)
-    return 1;
-  if (isc(ctx, e, &c))
-    return c < 0;
-  if ((nd->op == DM_EXPR_MUL || nd->op == DM_EXPR_DIV) && isc(ctx, nd->a, &c))
-    return c < 0;
-  return 0;
-}
-
-dm_expr dm_expr_neg(dm_expr_ctx *ctx, dm_expr a)
-{
-  if (!check2(ctx, a, a))
-    return DM_EXPR_NONE;
-  const dm_node *nd = &ctx->node[a];
-  double c;
-  if (isc(ctx, a, &c))
-    return K(-c);
-  switch (nd->op) {
-  case DM_EXPR_NEG:
-    return nd->a;
-  case DM_EXPR_SUB:
-    return dm_expr_sub(ctx, nd->b, nd->a);
-  case DM_EXPR_MUL:
-    if (isc(ctx, nd->a, &c))
-      return dm_expr_mul(ctx, K(-c), nd->b);
-    break;
-  default:
-    break;
-  }
-  return cons(ctx, DM_EXPR_NEG, a, -1, -1);
-}
-
-dm_expr dm_expr_add(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (!check2(ctx, a, b))
-    return DM_EXPR_NONE;
-  double ca, cb;
-  int ka = isc(ctx, a, &ca), kb = isc(ctx, b, &cb);
-  if (ka && kb)
-    return K(ca + cb);
-  if (ka && ca == 0)
-    return b;
-  if (kb && cb == 0)
-    return a;
-  /* like terms */
-  dm_expr ta, tb;
-  ca = split_coef(ctx, a, &ta);
-  cb = split_coef(ctx, b, &tb);
-  if (ta == tb && !ka && !kb)
-    return dm_expr_mul(ctx, K(ca + cb), ta);
-  /* common constant factor: c*x + c*y -> c*(x + y), c*x - c*y likewise */
-  if (!ka && !kb && (ca == cb || ca == -cb) && ca != 1 && ca != -1) {
-    dm_expr s = ca == cb ? dm_expr_add(ctx, ta, tb) : dm_expr_sub(ctx, ta, tb);
-    return dm_expr_mul(ctx, K(ca), s);
-  }
-  dm_expr f, fx, fy;
-  if ((f = common_factor(ctx, a, b, &fx, &fy)) != DM_EXPR_NONE)
-    return dm_expr_mul(ctx, f, dm_expr_add(ctx, fx, fy));
-  /* x + (-y) -> x - y */
-  if (negative_looking(ctx, b))
-    return dm_expr_sub(ctx, a, dm_expr_neg(ctx, b));
-  if (negative_looking(ctx, a))
-    return dm_expr_sub(ctx, b, dm_expr_neg(ctx, a));
-  if (ka) {                 /* constants last: x + 1 */
-    dm_expr t = a;
-    a = b;
-    b = t;
-  }
-  return cons_comm(ctx, DM_EXPR_ADD, a, b);
-}
-
-dm_expr dm_expr_sub(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (!check2(ctx, a, b))
-    return DM_EXPR_NONE;
-  double ca, cb;
-  int ka = isc(ctx, a, &ca), kb = isc(ctx, b, &cb);
-  if (ka && kb)
-    return K(ca - cb);
-  if (kb && cb == 0)
-    return a;
-  if (ka && ca == 0)
-    return dm_expr_neg(ctx, b);
-  if (a == b)
-    return K(0.0);
-  if (ctx->node[a].op == DM_EXPR_NEG && !kb) {  /* -x - y -> -(x + y): the */
-    dm_expr x = ctx->node[a].a;                 /* sign moves up where a   */
-    return dm_expr_neg(ctx, dm_expr_add(ctx, x, b));  /* sum absorbs it   */
-  }
-  dm_expr ta, tb;
-  ca = split_coef(ctx, a, &ta);
-  cb = split_coef(ctx, b, &tb);
-  if (ta == tb && !ka && !kb)
-    return dm_expr_mul(ctx, K(ca - cb), ta);
-  if (!ka && !kb && (ca == cb || ca == -cb) && ca != 1 && ca != -1) {
-    dm_expr s = ca == cb ? dm_expr_sub(ctx, ta, tb) : dm_expr_add(ctx, ta, tb);
-    return dm_expr_mul(ctx, K(ca), s);
-  }
-  dm_expr f, fx, fy;
-  if ((f = common_factor(ctx, a, b, &fx, &fy)) != DM_EXPR_NONE)
-    return dm_expr_mul(ctx, f, dm_expr_sub(ctx, fx, fy));
-  if (negative_looking(ctx, b))
-    return dm_expr_add(ctx, a, dm_expr_neg(ctx, b));
-  return cons(ctx, DM_EXPR_SUB, a, b, -1);
-}
-
-dm_expr dm_expr_mul(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (!check2(ctx, a, b))
-    return DM_EXPR_NONE;
-  double ca, cb;
-  if (isc(ctx, b, &cb) && !isc(ctx, a, &ca)) {   /* constant first */
-    dm_expr t = a;
-    a = b;
-    b = t;
-  }
-  int ka = isc(ctx, a, &ca), kb = isc(ctx, b, &cb);
-  if (ka && kb)
-    return K(ca * cb);
-  if (ka) {
-    const dm_node *nb = &ctx->node[b];
-    double c2;
-    if (ca == 0)
-      return K(0.0);
-    if (ca == 1)
-      return b;
-    if ((nb->op == DM_EXPR_MUL || nb->op == DM_EXPR_DIV) && isc(ctx, nb->a, &c2)) {
-      dm_expr t = nb->b, k = K(ca * c2);
-      return nb->op == DM_EXPR_MUL ? dm_expr_mul(ctx, k, t)
-                                   : dm_expr_div(ctx, k, t);
-    }
-    if (nb->op == DM_EXPR_NEG)
-      return dm_expr_mul(ctx, K(-ca), nb->a);
-    if (ca == -1)
-      return dm_expr_neg(ctx, b);
-    return cons(ctx, DM_EXPR_MUL, a, b, -1);
-  }
-  /* pull constant factors and signs to the front */
-  dm_expr ta, tb;
-  ca = split_coef(ctx, a, &ta);
-  cb = split_coef(ctx, b, &tb);
-  if (ca != 1 || cb != 1) {
-    dm_expr k = K(ca * cb);
-    return dm_expr_mul(ctx, k, dm_expr_mul(ctx, ta, tb));
-  }
-  /* x^m * x^n -> x^(m+n) */
-  int na = split_pow(ctx, a, &ta), nb = split_pow(ctx, b, &tb);
-  if (ta == tb && (long)na + nb != 0 && labs((long)na + nb) < INT32_MAX)
-    return dm_expr_powi(ctx, ta, na + nb);
-  return cons_comm(ctx, DM_EXPR_MUL, a, b);
-}
-
-/* 1/c is exact when c is a power of two (and 1/c does not overflow). */
-static int exact_recip(double c)
-{
-  int ex;
-  double m = frexp(c, &ex);
-  return (m == 0.5 || m == -0.5) && isfinite(1.0 / c) && 1.0 / c != 0;
-}
-
-dm_expr dm_expr_div(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (!check2(ctx, a, b))
-    return DM_EXPR_NONE;
-  double ca, cb;
-  int ka = isc(ctx, a, &ca), kb = isc(ctx, b, &cb);
-  if (ka && kb)
-    return K(ca / cb);
-  if (kb) {
-    if (cb == 1)
-      return a;
-    if (cb == -1)
-      return dm_expr_neg(ctx, a);
-    if (exact_recip(cb))
-      return dm_expr_mul(ctx, K(1.0 / cb), a);
-  }
-  if (ka && ca == 0 && !kb)
-    return K(0.0);
-  if (ka && ca < 0) {       /* -c/x is -(c/x): negations cancel upwards */
-    dm_expr k = K(-ca);
-    return dm_expr_neg(ctx, dm_expr_div(ctx, k, b));
-  }
-  const dm_node *nb = &ctx->node[b];
-  if (nb->op == DM_EXPR_NEG)
-    return dm_expr_neg(ctx, dm_expr_div(ctx, a, nb->a));
-  if (!ka) {
-    dm_expr ta, tb;
-    ca = split_coef(ctx, a, &ta);
-    if (ca != 1) {          /* (c*x)/y -> c*(x/y), -x/y -> -(x/y) */
-      dm_expr k = K(ca);
-      return dm_expr_mul(ctx, k, dm_expr_div(ctx, ta, b));
-    }
-    if (!kb) {
-      int na = split_pow(ctx, a, &ta), nbp = split_pow(ctx, b, &tb);
-      if (ta == tb && (long)na - nbp != 0 && labs((long)na - nbp) < INT32_MAX)
-        return dm_expr_powi(ctx, ta, na - nbp);
-    }
-  }
-  return cons(ctx, DM_EXPR_DIV, a, b, -1);
-}
-
 /* x^n exactly as the tape and the native code compute it. */
 double dm_expr__powi_value(double x, int n);
 double dm_expr__powi_value(double x, int n)
 {
   return dm_tape_powi(x, n);
-}
-
-dm_expr dm_expr_powi(dm_expr_ctx *ctx, dm_expr a, int n)
-{
-  if (!check2(ctx, a, a))
-    return DM_EXPR_NONE;
-  double c;
-  if (n == 0)
-    return K(1.0);
-  if (n == 1)
-    return a;
-  if (isc(ctx, a, &c))
-    return K(dm_expr__powi_value(c, n));
-  const dm_node *nd = &ctx->node[a];
-  if (nd->op == DM_EXPR_POWI) {
-    long long m = (long long)nd->b * n;
-    if (m > -INT32_MAX && m < INT32_MAX)
-      return dm_expr_powi(ctx, nd->a, (int)m);
-  }
-  if (nd->op == DM_EXPR_NEG) {
-    dm_expr p = dm_expr_powi(ctx, nd->a, n);
-    return (n % 2 == 0) ? p : dm_expr_neg(ctx, p);
-  }
-  return cons(ctx, DM_EXPR_POWI, a, n, -1);
 }
 
 dm_expr dm_expr_pow(dm_expr_ctx *ctx, dm_expr a, dm_expr b)

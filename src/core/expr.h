@@ -6,12 +6,18 @@
  * and nodes never change.  Children always have smaller handles than their
  * parents, so ascending handle order is a topological order.
  *
- * Construction hash-conses (structurally equal nodes are one node), folds
- * constants, applies the safe identities (x+0, x*1, 0*x, x-x, -(-x),
- * (x^m)^n for integers, like terms c1*t + c2*t, x^m*x^n, common factors
- * c*x + c*y) and treats commutative operations canonically: a*b and b*a
- * are one node, whose operands keep the order of first construction
- * (constants go first in products, last in sums).
+ * Construction hash-conses (structurally equal nodes are one node) and
+ * keeps sums and products in a normal form (expr_norm.c): flattened, like
+ * terms collected (t + t -> 2*t, c1*t + c2*t -> (c1 + c2)*t, t - t -> 0),
+ * equal factors collected into integer powers (x*x -> x^2, x^2*x -> x^3,
+ * x/x -> 1, (x^m)^n -> x^(m*n)), constants folded, a coefficient common to
+ * every term taken out (0.5*x + 0.5*y -> 0.5*(x + y)); sums and products
+ * equal up to order and grouping are one node, which keeps the order of
+ * first construction for printing (coefficient first, the first positive
+ * term first, the constant last: 2*m2*cos(phi)*r1*r2, x - y + 3).  The
+ * identities that change IEEE results (t - t, 0*t, x/x, x^m*x^n where x
+ * is 0, Inf or NaN: the written form is NaN there) are listed in
+ * expr_norm.c; apart from them, results differ by rounding only.
  *
  * Error behaviour: builders return DM_EXPR_NONE on failure (out of memory,
  * wrong arity, invalid handle, unknown name) and record the reason in the

@@ -3,17 +3,45 @@
 #ifndef DM_EXPR_IMPL_H
 #define DM_EXPR_IMPL_H
 
+#include <string.h>
+
 #include "expr.h"
 
 /* One node: 16 bytes.  Leaves: CONST (a = index into cval), SYM / PARAM
  * (a = name index).  POWI: a = base, b = exponent.  Others: operands a, b, c
- * (unused ones are -1). */
+ * (unused ones are -1).  len: for sums and products built by expr_norm.c,
+ * the number of their terms / factors (saturating at 65535; 0 unknown). */
 typedef struct dm_node {
   uint8_t op;
   uint8_t flags;            /* DM_NF_* */
-  uint16_t pad;
+  uint16_t len;
   int32_t a, b, c;
 } dm_node;
+
+/* One term of a sum (key: the term without its constant coefficient c;
+ * k: DM_NE_PLAIN c*key, DM_NE_RECIP c/key, DM_NE_CONST the constant c) or
+ * one factor of a product (key: the base, k: its integer exponent).  src:
+ * which operand it came from. */
+typedef struct dm_nel {
+  int32_t key, k;
+  double c;
+  uint64_t h;               /* hash of the element */
+  int32_t src, pad;
+} dm_nel;
+enum { DM_NE_PLAIN = 0, DM_NE_RECIP = 1, DM_NE_CONST = 2 };
+
+/* A node pending in a flattening walk: node and sign / exponent. */
+typedef struct dm_nwalk {
+  int32_t node, pad;
+  int64_t e;
+} dm_nwalk;
+
+/* The table of normal sums and products by the multiset of their
+ * elements (hash h). */
+typedef struct dm_nslot {
+  uint64_t h;
+  int32_t node, pad;
+} dm_nslot;
 
 enum { DM_NF_SYM = 1u, DM_NF_PARAM = 2u };
 
@@ -41,6 +69,13 @@ struct dm_expr_ctx {
   size_t scap;
   int32_t *stack, *list;    /* traversal buffers */
   size_t stackcap, listcap;
+  /* normal forms (expr_norm.c) */
+  dm_nel *nel[2];           /* element lists: [0] being built, [1] compared */
+  size_t nelcap[2];
+  dm_nwalk *walk;           /* flattening stack */
+  size_t walkcap;
+  dm_nslot *ftab;           /* normal sums / products by element multiset */
+  size_t ftabcap, nftab;
   dm_err err;
 };
 
@@ -50,6 +85,23 @@ dm_expr dm_expr__fail(dm_expr_ctx *ctx, int status, const char *fmt, ...)
   __attribute__((format(printf, 3, 4)))
 #endif
   ;
+
+static inline uint64_t dm_expr__mix64(uint64_t h)
+{
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  h *= 0xc4ceb9fe1a85ec53ULL;
+  h ^= h >> 33;
+  return h;
+}
+
+static inline uint64_t dm_expr__dbits(double x)
+{
+  uint64_t u;
+  memcpy(&u, &x, sizeof u);
+  return u;
+}
 
 static inline int dm_expr__valid(const dm_expr_ctx *ctx, dm_expr e)
 {
@@ -90,15 +142,10 @@ dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c)
 /* The context's error status copied into err (DM_EFAILED if none). */
 int dm_expr__status(dm_expr_ctx *ctx, dm_err *err);
 
-/* Derivative memo: the result for (node, var) or -1; store one. */
-int32_t dm_expr__memo_get(const dm_expr_ctx *ctx, int32_t node, int32_t var);
-int dm_expr__memo_put(dm_expr_ctx *ctx, int32_t node, int32_t var, int32_t res);
+/* The constant node x (as dm_expr_const). */
+dm_expr dm_expr__k(dm_expr_ctx *ctx, double x);
+/* Release the normal-form buffers and table (expr_norm.c). */
+void dm_expr__norm_free(dm_expr_ctx *ctx);
 
-/* The node (op, a, b, c) exactly, without simplification (not CONST;
- * unused operands -1). */
-dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c);
-
-/* The context's error status copied into err (DM_EFAILED if none). */
-int dm_expr__status(dm_expr_ctx *ctx, dm_err *err);
 
 #endif

@@ -239,13 +239,15 @@ static dm_native_map *make_outmap(const block *blk, size_t nblk, size_t nout,
 }
 
 /* Compile a bundle: the tape, and native code (with its scattering
- * function for the blocks) when the mode asks for it. */
+ * function for the blocks) when the mode asks for it.  exact: out was
+ * rewritten by dm_tape_optimize already (so that bundles sharing outputs
+ * compute them identically). */
 static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
-                        size_t nin, const block *blk, size_t nblk)
+                        size_t nin, const block *blk, size_t nblk, int exact)
 {
   const dm_lagrangian_spec *sp = b->sp;
-  int s = dm_tape_compile(b->ctx, nout, out, nin, b->in, sp->npar, sp->par,
-                          &p->tape, b->err);
+  int s = (exact ? dm_tape_compile_exact : dm_tape_compile)(b->ctx, nout,
+          out, nin, b->in, sp->npar, sp->par, &p->tape, b->err);
   if (s != DM_OK)
     return s;
   p->nout = nout;
@@ -402,7 +404,7 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
   dm_lagrangian_spec tsp = *sp;
   tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
   nb.sp = &tsp;
-  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0);
+  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0, 0);
   if (s != DM_OK)
     return s;
   d->mass_possible = 1;
@@ -453,9 +455,20 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
   const block blk[] = { { 0, BLK_VEC, 1, 1, 0 }, { 1, BLK_VEC, n, 1, 0 },
                         { 2, BLK_VEC, n, 1, 0 }, { 3, BLK_SYM, n, 1, 0 },
                         { 4, BLK_FULL, n, 1, 0 }, { 5, BLK_SYM, n, 1, 0 } };
-  if ((s = compile_prog(b, &d->grad, 1 + 2 * n, out, 2 * n, blk, 6)) != DM_OK ||
-      (s = compile_prog(b, &d->all, nall, out, 2 * n, blk, 6)) != DM_OK)
+  /* rewritten once for both bundles: the gradient alone and with the
+   * Hessian are computed the same way, bit for bit */
+  dm_expr *ow = malloc(nall * sizeof *ow);
+  if (ow == NULL) {
+    s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
     goto done;
+  }
+  if ((s = dm_tape_optimize(b->ctx, nall, out, ow, b->err)) != DM_OK ||
+      (s = compile_prog(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = compile_prog(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK) {
+    free(ow);
+    goto done;
+  }
+  free(ow);
   s = detect_structure(b, d, Lv, Lvv, Lvq, flags);
 done:
   free(out);
@@ -479,9 +492,11 @@ static int build_force(builder *b, lag_data *d)
       dm_expr_jacobian(b->ctx, n, sp->force, n, sp->v, out + n + n * n, NULL) != DM_OK)
     s = ctx_fail(b, "force");
   if (s == DM_OK)
-    s = compile_prog(b, &d->force, n, out, 2 * n, blk, 3);
+    s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
   if (s == DM_OK)
-    s = compile_prog(b, &d->force_all, nall, out, 2 * n, blk, 3);
+    s = compile_prog(b, &d->force, n, out, 2 * n, blk, 3, 1);
+  if (s == DM_OK)
+    s = compile_prog(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
   free(out);
   return s;
 }
@@ -508,9 +523,11 @@ static int build_constraints(builder *b, lag_data *d)
   if (s == DM_OK && dm_expr_ctx_err(b->ctx)->status != DM_OK)
     s = ctx_fail(b, "constraints");
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr, m + m * n, out, n, blk, 3);
+    s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr_all, nall, out, n, blk, 3);
+    s = compile_prog(b, &d->constr, m + m * n, out, n, blk, 3, 1);
+  if (s == DM_OK)
+    s = compile_prog(b, &d->constr_all, nall, out, n, blk, 3, 1);
   free(out);
   return s;
 }

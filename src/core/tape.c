@@ -131,64 +131,6 @@ static int check_vars(dm_expr_ctx *ctx, size_t nin, const dm_expr *in,
   return DM_OK;
 }
 
-/* Divisions by a common denominator b become products with one shared
- * reciprocal 1/b (a division costs several multiplications): out[] is
- * rewritten into nw[] through unsimplified nodes. */
-static int share_reciprocals(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
-                             dm_expr *nw, dm_err *err)
-{
-  long nl = dm_expr__collect(ctx, nout, out);
-  if (nl < 0)
-    return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  size_t sz = (size_t)(nl ? nl : 1);
-  int32_t *L = malloc(sz * sizeof *L), *img = malloc(sz * sizeof *img);
-  if (L == NULL || img == NULL) {
-    free(L);
-    free(img);
-    return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  }
-  memcpy(L, ctx->list, sz * sizeof *L);
-  int32_t *uses = ctx->aux;               /* divisions by each node */
-  int any = 0;
-  for (long p = 0; p < nl; p++)
-    uses[L[p]] = 0;
-  for (long p = 0; p < nl; p++)
-    if (ctx->node[L[p]].op == DM_EXPR_DIV)
-      any |= ++uses[ctx->node[L[p]].b] >= 2;
-  int s = DM_OK;
-  dm_expr one = dm_expr_const(ctx, 1.0);
-  for (long p = 0; any && s == DM_OK && p < nl; p++) {
-    const dm_node nd = ctx->node[L[p]];
-    int k = dm_expr__arity(nd.op);
-    int32_t ops[3] = { nd.a, nd.b, nd.c }, nops[3] = { -1, -1, -1 };
-    int changed = 0;
-    for (int j = 0; j < k; j++) {         /* (POWI: b is the exponent) */
-      int32_t *hit = bsearch(&ops[j], L, (size_t)nl, sizeof *L, cmp_i32);
-      nops[j] = img[hit - L];
-      changed |= nops[j] != ops[j];
-    }
-    if (nd.op == DM_EXPR_POWI)
-      nops[1] = nd.b;
-    dm_expr y = L[p];
-    if (nd.op == DM_EXPR_DIV && uses[nd.b] >= 2 && !(nd.a == one)) {
-      dm_expr r = dm_expr__cons(ctx, DM_EXPR_DIV, one, nops[1], -1);
-      y = dm_expr__cons(ctx, DM_EXPR_MUL, nops[0], r, -1);
-    } else if (changed) {
-      y = dm_expr__cons(ctx, nd.op, nops[0], nops[1], nops[2]);
-    }
-    if (y == DM_EXPR_NONE)
-      s = dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-    img[p] = y;
-  }
-  for (size_t k = 0; k < nout; k++) {
-    int32_t *hit = any ? bsearch(&out[k], L, (size_t)nl, sizeof *L, cmp_i32) : NULL;
-    nw[k] = hit ? img[hit - L] : out[k];
-  }
-  free(L);
-  free(img);
-  return s;
-}
-
 /* One planned instruction: its op and the list positions of its result
  * and operands (-1: none; for POWI the exponent is in imm). */
 typedef struct plan {
@@ -217,12 +159,13 @@ static void build_free(build *b)
   free(b->plans);
 }
 
-/* A plain product used by exactly one instruction and not an output can be
- * folded into that instruction. */
+/* A plain product or square used by exactly one instruction and not an
+ * output can be folded into that instruction. */
 static int foldable(const build *b, int32_t q)
 {
   int32_t k = b->planned[q];
-  return k >= 0 && b->plans[k].op == DM_T_MUL && b->uses[q] == 1;
+  return k >= 0 && (b->plans[k].op == DM_T_MUL || b->plans[k].op == DM_T_SQR)
+         && b->uses[q] == 1;
 }
 
 /* Plan the instruction of the node at position p (operand positions from
@@ -260,7 +203,7 @@ static void plan_node(const dm_expr_ctx *ctx, build *b, long p)
                : left ? DM_T_MULSUB : DM_T_SUBMUL;
       pl->op = op;
       pl->opnd[0] = pm->opnd[0];
-      pl->opnd[1] = pm->opnd[1];
+      pl->opnd[1] = pm->op == DM_T_SQR ? pm->opnd[0] : pm->opnd[1];
       pl->opnd[2] = other;
       pm->op = DM_T_NOPS;                     /* folded away */
       b->planned[m] = -1;
@@ -415,9 +358,10 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
   return DM_OK;
 }
 
-int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
-                    size_t nin, const dm_expr *in, size_t npar,
-                    const dm_expr *par, dm_tape **tape, dm_err *err)
+static int compile_with(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                        size_t nin, const dm_expr *in, size_t npar,
+                        const dm_expr *par, int rewrite, dm_tape **tape,
+                        dm_err *err)
 {
   *tape = NULL;
   for (size_t k = 0; k < nout; k++)
@@ -435,7 +379,10 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
     free(nw);
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   }
-  s = share_reciprocals(ctx, nout, out, nw, err);
+  if (rewrite)
+    s = dm_tape__optimize(ctx, nout, out, nw, err);
+  else
+    memcpy(nw, out, nout * sizeof *nw);
   if (s == DM_OK)
     s = compile(ctx, t, &b, nout, nw, nin, in, npar, par, err);
   free(nw);
@@ -448,3 +395,26 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
   return DM_OK;
 }
 
+int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                    size_t nin, const dm_expr *in, size_t npar,
+                    const dm_expr *par, dm_tape **tape, dm_err *err)
+{
+  return compile_with(ctx, nout, out, nin, in, npar, par, 1, tape, err);
+}
+
+int dm_tape_compile_exact(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                          size_t nin, const dm_expr *in, size_t npar,
+                          const dm_expr *par, dm_tape **tape, dm_err *err)
+{
+  return compile_with(ctx, nout, out, nin, in, npar, par, 0, tape, err);
+}
+
+int dm_tape_optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                     dm_expr *nw, dm_err *err)
+{
+  for (size_t k = 0; k < nout; k++)
+    if (!dm_expr__valid(ctx, out[k]))
+      return dm_err_set(err, DM_EINVAL, "tape: output %zu is not a valid "
+                        "expression", k + 1);
+  return dm_tape__optimize(ctx, nout, out, nw, err);
+}

@@ -2,9 +2,12 @@
  * evaluation loop.
  *
  * dm_tape_compile turns (outputs, inputs, parameters) of an expression
- * context into a tape: the nodes reachable from the outputs in topological
- * order, one instruction each (shared subexpressions are computed once,
- * constants live in a pool), on registers reused by liveness.  Register
+ * context into a tape: the outputs are first rewritten for evaluation
+ * (tape_opt.c: sums factored greedily, powers by products, shared
+ * reciprocals), then the nodes reachable from them are laid out in
+ * topological order, one instruction each (shared subexpressions are
+ * computed once, constants live in a pool; a product used once is fused
+ * into its user), on registers reused by liveness.  Register
  * layout: [0, nin) inputs, [nin, nin+npar) parameters, then the constant
  * pool, then temporaries.
  *
@@ -66,6 +69,20 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
                     size_t nin, const dm_expr *in, size_t npar,
                     const dm_expr *par, dm_tape **tape, dm_err *err);
 void dm_tape_free(dm_tape *t);
+
+/* The outputs rewritten the way dm_tape_compile rewrites them before
+ * compiling (sums factored, powers and reciprocals shared; values equal up
+ * to rounding), as new nodes of the context that are never simplified:
+ * nw[nout].  Compiling any of them with dm_tape_compile_exact computes
+ * them with exactly the same operations, whatever else is compiled along,
+ * so bundles that share outputs (L and its gradient alone, and with the
+ * Hessian) give bit-identical values. */
+int dm_tape_optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                     dm_expr *nw, dm_err *err);
+/* dm_tape_compile without the rewriting: every node as it is. */
+int dm_tape_compile_exact(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                          size_t nin, const dm_expr *in, size_t npar,
+                          const dm_expr *par, dm_tape **tape, dm_err *err);
 
 /* out[nout] = outputs at (in[nin], par[npar]); work has dm_tape_work_size
  * doubles.  in / par may be NULL when nin / npar is 0.  in may be work

@@ -14,4 +14,10 @@ struct dm_tape {
   uint32_t *outreg;
 };
 
+/* Rewrite the outputs out[nout] for compiling (factored sums, shared
+ * powers and reciprocals; tape_opt.c) into nw[nout], with nodes built
+ * without simplification.  Uses the context's traversal scratch. */
+int dm_tape__optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                      dm_expr *nw, dm_err *err);
+
 #endif

@@ -65,8 +65,9 @@ static void test_against_eval(void)
     for (size_t k = 0; k < nout; k++)
       worst = fmax(worst, relerr(y[k], ref[k]));
   }
-  tap_ok(worst < 1e-13, "tape = DAG evaluation to round-off at 20 random "
-         "points (max rel diff %.2g; shared reciprocals round differently)", worst);
+  tap_ok(worst < 1e-12, "tape = DAG evaluation to round-off at 20 random "
+         "points (max rel diff %.2g: the tape computes factored sums, shared "
+         "reciprocals; d2/dx2 of (x^2 - y^2)/(x - y) cancels terms ~300)", worst);
 
   /* batch over 77 points (not a multiple of the block) = single evals */
   enum { NP = 77 };
@@ -113,13 +114,14 @@ static void test_params_and_sharing(void)
   tap_ok(dm_tape_nregs(t) <= 64, "fits the work buffer");
   dm_tape_free(t);
 
-  /* a long chain reuses registers: sum of x^i/i for i = 1..200 */
+  /* a long chain reuses registers: sum of x^i/i for i = 1..200 (factored
+   * into Horner's rule: one fused multiply-add per term) */
   dm_expr sum = dm_expr_const(C, 0);
   for (int i = 1; i <= 200; i++)
     sum = dm_expr_add(C, sum, dm_expr_div(C, dm_expr_powi(C, V[0], i), dm_expr_const(C, i)));
   dm_tape_compile(C, 1, &sum, 1, V, 0, NULL, &t, NULL);
   size_t tmp = dm_tape_nregs(t) - 1 - dm_tape_nconst(t);
-  tap_ok(dm_tape_ninstr(t) >= 400 && tmp <= 6, "liveness: %zu instructions use "
+  tap_ok(dm_tape_ninstr(t) >= 200 && tmp <= 6, "liveness: %zu instructions use "
          "%zu temporaries", dm_tape_ninstr(t), tmp);
   double val, ws[1024], want = 0;
   x = 0.5;
