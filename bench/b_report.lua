@@ -58,7 +58,7 @@ local function time_to(pts, key, target)
     local y = p[key]
     if type(y) == "number" and y <= target then
       local q = pts[i - 1]
-      if not q or type(q[key]) ~= "number" or q[key] <= target then return p.cpu_s end
+      if not q or type(q[key]) ~= "number" or q[key] <= target then return p.cpu_s, i == 1 end
       local a = (math.log(target) - math.log(q[key])) / (math.log(y) - math.log(q[key]))
       return math.exp(math.log(q.cpu_s) + a * (math.log(p.cpu_s) - math.log(q.cpu_s)))
     end
@@ -140,15 +140,15 @@ for _, prob in ipairs({"kepler", "j2"}) do
            p.reps, p.err_end, p.max_dH)
       end
     end
-    md("\nCPU seconds to reach a target (log-log interpolation along each curve; - : not reached):\n")
+    md("\nCPU seconds to reach a target (log-log interpolation along each curve; <= : the cheapest point is already below it; - : not reached):\n")
     md("| method | error at T <= 1e-4 | error at T <= 1e-8 | max abs dH <= 1e-8 | max abs dH <= 1e-12 |")
     md("|---|---:|---:|---:|---:|")
     for _, m in ipairs(order) do
       local pts = by[m]
       table.sort(pts, function(a, b) return a.cpu_s < b.cpu_s end)
       local function f(key, tgt)
-        local t = time_to(pts, key, tgt)
-        return t and ("%.3g"):format(t) or "-"
+        local t, first = time_to(pts, key, tgt)
+        return t and ((first and "<= " or "") .. ("%.3g"):format(t)) or "-"
       end
       md("| %s | %s | %s | %s | %s |", m, f("err_end", 1e-4), f("err_end", 1e-8), f("max_dH", 1e-8),
          f("max_dH", 1e-12))
