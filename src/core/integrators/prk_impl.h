@@ -12,6 +12,9 @@ enum dm_prk_mode {
   DM_PRK_DLEG       /* V, p0 (n): boundary problem for given (q0, q1) */
 };
 
+/* Structure of a constant mass matrix (explicit Stormer-Verlet). */
+enum dm_prk_mass { DM_MASS_FULL, DM_MASS_DIAG, DM_MASS_UNIT };
+
 struct dm_prk {
   const dm_system *sys;
   dm_tableau *tab;             /* owned copy */
@@ -46,7 +49,7 @@ struct dm_prk {
   double *cq, *cp;             /* Kahan carries */
   /* separable systems */
   double *Minv;                /* n x n */
-  int unit_mass;               /* M = I: skip the M^{-1} product */
+  int mass_kind;               /* DM_MASS_UNIT / _DIAG / _FULL: how M^{-1} applies */
   double *svf;                 /* Lq at hq1 (first same as last) */
   int svf_valid;
   dm_legendre_ws *leg;

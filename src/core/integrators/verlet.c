@@ -40,10 +40,15 @@ int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
     return dm_err_set(e, DM_EINVAL, "system '%s' is flagged separable but its mass matrix is not "
                       "symmetric positive definite", sys->name ? sys->name : "?");
   P->explicit_sv = 1;
-  P->unit_mass = 1;
+  P->mass_kind = DM_MASS_UNIT;
   for (size_t i = 0; i < n * n; i++)
-    if (sys->mass[i] != (i / n == i % n ? 1.0 : 0.0))
-      P->unit_mass = 0;
+    if (i / n != i % n && sys->mass[i] != 0.0)
+      P->mass_kind = DM_MASS_FULL;
+    else if (i / n == i % n && sys->mass[i] != 1.0 && P->mass_kind == DM_MASS_UNIT)
+      P->mass_kind = DM_MASS_DIAG;
+  if (P->mass_kind == DM_MASS_DIAG)      /* exact reciprocals, not the Cholesky inverse */
+    for (size_t i = 0; i < n; i++)
+      P->Minv[i * n + i] = 1.0 / sys->mass[i * n + i];
   return DM_OK;
 }
 
@@ -54,19 +59,26 @@ static int force_at(dm_prk *P, const double *q, double *f, dm_err *e)
   return dm_eval_lag(P->sys, q, P->v1w, DM_LAG_Q, &o, P->work, e);
 }
 
-static void minv_mul(const dm_prk *P, const double *x, double *y)
+static inline void minv_mul(const dm_prk *P, const double *x, double *y)
 {
   size_t n = P->n, i, j;
-  if (P->unit_mass) {
+  const double *Mi = P->Minv;
+  switch (P->mass_kind) {
+  case DM_MASS_UNIT:
     for (i = 0; i < n; i++)
       y[i] = x[i];
-    return;
-  }
-  for (i = 0; i < n; i++) {
-    double acc = 0.0;
-    for (j = 0; j < n; j++)
-      acc += P->Minv[i * n + j] * x[j];
-    y[i] = acc;
+    break;
+  case DM_MASS_DIAG:
+    for (i = 0; i < n; i++)
+      y[i] = Mi[i * n + i] * x[i];
+    break;
+  default:
+    for (i = 0; i < n; i++) {
+      double acc = 0.0;
+      for (j = 0; j < n; j++)
+        acc += Mi[i * n + j] * x[j];
+      y[i] = acc;
+    }
   }
 }
 
@@ -213,6 +225,7 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
   size_t n = P->n, i;
   double *f0 = P->Lq, *f1 = P->Lq + n, *u = P->X, *q1 = P->q1w, *ph = P->dp, *tmp;
   double *cq = P->cq, *cp = P->cp;
+  const double hh = 0.5 * h;
   dm_lag_out o = {0, NULL, P->Lv + n, NULL, NULL, NULL};
   long k;
   int st = DM_OK, rc;
@@ -237,8 +250,9 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
       st = DM_EINTR;
       break;
     }
+    /* drift: u = M^{-1} (p + h/2 f0), q1 = q + h u, compensated */
     for (i = 0; i < n; i++)
-      ph[i] = p[i] + 0.5 * h * f0[i];
+      ph[i] = p[i] + hh * f0[i];
     minv_mul(P, ph, u);
     for (i = 0; i < n; i++) {
       double y = h * u[i] - cq[i], t = q[i] + y;
@@ -252,10 +266,10 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
         st = dm_err_set(e, rc > 0 ? DM_EDOM : DM_ECALLBACK, "force evaluation failed");
       break;
     }
+    /* kick: p1 = p + h/2 (f0 + f1), compensated; one finiteness test per step */
     for (i = 0; i < n; i++) {
-      double y = 0.5 * h * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
-      if (!isfinite(t) || !isfinite(q1[i]))
-        bad = 1;
+      double y = hh * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
+      bad |= !isfinite(t) | !isfinite(q1[i]);
       cp[i] = (t - p[i]) - y;
       ph[i] = t;
     }
