@@ -4,8 +4,8 @@
 # Called by `make bench-peers` (bench/peers.am) with:
 #   SRCDIR BUILDDIR DMECH RESULTS PYTHON B3_PERIODS B3_SCIPY_PERIODS
 # in the environment.  Every missing peer is reported as "skipped".
-# Outputs in $RESULTS: b1.txt, b1_lua.txt, b2_*.tsv, b2.txt, b3_*.tsv,
-# b3.txt, b5.txt, b2_*.png, b3_energy.png, tables.md, machine.txt.
+# Outputs in $RESULTS: b1.txt, b1_lua.txt, b2_*.tsv, b2_*.txt, b3_*.tsv,
+# b3_*.txt, b4.txt (the reduction module's bench_reduce), b5.txt, b2_*.png, b3_energy.png, tables.md, machine.txt.
 set -u
 : "${SRCDIR:?}" "${BUILDDIR:?}" "${DMECH:?}" "${RESULTS:?}"
 PYTHON=${PYTHON:-/usr/bin/python3}
@@ -86,7 +86,12 @@ section "B5 interactive"
   "$DMECH" "$SRCDIR/bench/b5_compile.lua"
 } > "$RESULTS/b5.txt" 2>&1 || status=1
 cat "$RESULTS/b5.txt"
-if [ -f "$RESULTS/b4.txt" ]; then section "B4 (from bench-reduce)"; cat "$RESULTS/b4.txt"; fi
+section "B4 reduction (bench/bench_reduce, from bench-reduce)"
+if [ -x "$BUILDDIR/bench/bench_reduce" ]; then
+  run B4 "$RESULTS/b4.txt" "$BUILDDIR/bench/bench_reduce"
+else
+  echo "B4: skipped (bench/bench_reduce not built)"
+fi
 
 section "report"
 run report "$RESULTS/report.log" "$DMECH" "$SRCDIR/bench/b_report.lua" "$RESULTS"
