@@ -40,7 +40,7 @@ run() { # run <name> <logfile> cmd... : tee output, record failure
   echo "cc: $(${CC:-cc} --version 2>/dev/null | head -1)"
   echo "CFLAGS: ${BENCH_CFLAGS:-?}"
   echo "GSL: $(gsl-config --version 2>/dev/null || echo ?)"
-  echo "dmech: $(cd "$SRCDIR" && git describe --always --dirty 2>/dev/null || echo ?)"
+  echo "dmech: ${DMECH_REV:-$(cd "$SRCDIR" && git describe --always --dirty 2>/dev/null || echo ?)}"
   if [ -x "$BUILDDIR/bench/peers/odeint_bench" ]; then echo "Boost.Odeint: $(sed -n 's/^#define BOOST_LIB_VERSION "\(.*\)"/\1/p' /usr/include/boost/version.hpp 2>/dev/null)"; else echo "Boost.Odeint: skipped (no headers or no C++ compiler; bench/setup.sh installs them)"; fi
   if "$PYTHON" -c 'import scipy' 2>/dev/null; then echo "SciPy: $("$PYTHON" -c 'import scipy, numpy, sys; print(scipy.__version__, "numpy", numpy.__version__, "python", sys.version.split()[0])')"; else echo "SciPy: skipped ($PYTHON has no scipy; bench/setup.sh installs python3-scipy)"; fi
 } > "$RESULTS/machine.txt"
