@@ -297,15 +297,18 @@ static int assemble(dm_prk *P, int mode, double h, const double *q0, const doubl
 
 /* Scaled size of the Newton update held in R: velocities relative to
  * max(|V|, momentum scale / |Lvv|), multipliers and p0 relative to
- * max(|x|, momentum scale) with momentum scale |p| + |h| |W|. */
-static double update_norm(const dm_prk *P, int mode, double h, const double *p0)
+ * max(|x|, momentum scale) with momentum scale |p| + |h| |W|.  rv and xv
+ * are max |R| and max |X| over the velocity block (computed by the caller
+ * while it applied the update). */
+static double update_norm(const dm_prk *P, int mode, double h, const double *p0, double rv,
+                          double xv)
 {
   size_t sn = P->sn, N = nunk(P, mode);
   const double *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
   double ms = dm_norm_inf(pp, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
   double lv = P->lvv_norm;      /* Lvv changes only with the Jacobian */
-  double vs = dm_max3(dm_norm_inf(P->X, sn), lv > 0 ? ms / lv : 0.0, DBL_MIN);
-  double d = dm_norm_inf(P->R, sn) / vs;
+  double vs = dm_max3(xv, lv > 0 ? ms / lv : 0.0, DBL_MIN);
+  double d = rv / vs;
   if (N > sn) {
     double xs = dm_max3(dm_norm_inf(P->X + sn, N - sn), ms, DBL_MIN);
     d = dm_max2(d, dm_norm_inf(P->R + sn, N - sn) / xs);
@@ -354,9 +357,24 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
         return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
     }
     dm_smalllu_solve(P->Jm, N, P->perm, P->R);
-    for (i = 0; i < N; i++)
-      P->X[i] -= P->R[i];
-    d = update_norm(P, mode, h, p0);
+    {
+      /* X -= R; max |R| and max |X| of the velocities on the way (a NaN
+       * in either makes d NaN: the test below catches it) */
+      double *X = P->X, rv = 0.0, xv = 0.0;
+      const double *R = P->R;
+      int nan = 0;
+      for (i = 0; i < P->sn; i++) {
+        double r = fabs(R[i]), x;
+        X[i] -= R[i];
+        x = fabs(X[i]);
+        rv = r > rv ? r : rv;
+        xv = x > xv ? x : xv;
+        nan |= (r != r) | (x != x);
+      }
+      for (; i < N; i++)
+        X[i] -= R[i];
+      d = update_norm(P, mode, h, p0, nan ? NAN : rv, xv);
+    }
     if (!isfinite(d))
       return dm_err_set(e, DM_EDOM, "non-finite Newton update (h = %g)", h);
     if (d <= P->tol) {
