@@ -20,8 +20,13 @@ typedef struct prog {
   dm_native_fn fn;
   dm_native_scatter_fn scatter;   /* native, writing the caller's arrays */
   size_t nout, nregs;
-  size_t nmap;                    /* tape path: output destinations */
-  struct dest { uint32_t reg, arr, elem; } *map;
+  /* tape path: output destinations, array by array: entries
+   * ast[a] .. ast[a+1] go to array a (register mreg[j] to element
+   * melem[j]), those from achk[a] on need no NaN/Inf test (constants,
+   * values tested at an earlier entry); full: the bits of every array */
+  uint32_t *mreg, *melem;
+  uint32_t narr, ast[33], achk[32];
+  unsigned full;
 } prog;
 
 typedef struct lag_data {
@@ -38,7 +43,8 @@ typedef struct lag_data {
 
 static void prog_free(prog *p)
 {
-  free(p->map);
+  free(p->mreg);
+  free(p->melem);
   dm_native_free(p->nat);
   dm_tape_free(p->tape);
   memset(p, 0, sizeof *p);
@@ -83,25 +89,46 @@ static inline double *prog_run(const prog *p, double *w, const double *par)
   return o;
 }
 
-/* The tape path of a callback: run on the inputs already in w, test the
- * outputs in their registers, scatter them to the arrays of out[] whose
- * bit is in mask.  Returns 1 (nothing written) for NaN or Inf. */
+/* Bit 63 set when x is NaN or infinite (its exponent is all ones): ORed
+ * over many values without floating-point compares. */
+static inline uint64_t nonfinite_bit(double x)
+{
+  uint64_t u;
+  memcpy(&u, &x, sizeof u);
+  return (u & 0x7ff0000000000000ULL) + 0x0010000000000000ULL;
+}
+
+/* The tape path of a callback: run on the inputs already in w, scatter the
+ * outputs to the arrays of out[] whose bit is in mask, testing them on the
+ * way.  Returns 1 when an output is NaN or Inf (the arrays are then partly
+ * written): every output is tested, requested or not, as native code
+ * does. */
 static int tape_scatter(const prog *p, double *w, const double *par,
                         double *const *out, unsigned mask)
 {
   dm_tape_run(p->tape, w, par, w);
-  const uint32_t *reg = dm_tape_outregs(p->tape);
-  int bad = 0;
-  for (size_t k = 0; k < p->nout; k++)
-    bad |= !(fabs(w[reg[k]]) <= DBL_MAX);
-  if (bad)
-    return 1;             /* outside the domain: retry with another step */
-  for (size_t j = 0; j < p->nmap; j++) {
-    const struct dest *dj = &p->map[j];
-    if (mask & (1u << dj->arr))
-      out[dj->arr][dj->elem] = w[dj->reg];
+  uint64_t bad = 0;
+  if ((mask & p->full) != p->full) {
+    const uint32_t *reg = dm_tape_outregs(p->tape);
+    for (size_t k = 0; k < p->nout; k++)
+      bad |= nonfinite_bit(w[reg[k]]);
   }
-  return 0;
+  const uint32_t *reg = p->mreg, *elem = p->melem;
+  const uint32_t narr = p->narr;
+  for (uint32_t a = 0; a < narr; a++) {
+    const uint32_t j0 = p->ast[a], jc = p->achk[a], j1 = p->ast[a + 1];
+    double *dst = out[a];
+    if (!(mask & (1u << a)))
+      continue;
+    for (uint32_t j = j0; j < jc; j++) {
+      double x = w[reg[j]];
+      bad |= nonfinite_bit(x);
+      dst[elem[j]] = x;
+    }
+    for (uint32_t j = jc; j < j1; j++)
+      dst[elem[j]] = w[reg[j]];
+  }
+  return (int)(bad >> 63);
 }
 
 static inline void copy(double *dst, const double *src, size_t k)
@@ -255,16 +282,46 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
   size_t nmap = 0, n = sp->n;
   dm_native_map *inmap = malloc((nin + 1) * sizeof *inmap);
   dm_native_map *outmap = make_outmap(blk, nblk, nout, &nmap);
-  p->map = malloc((nmap + 1) * sizeof *p->map);
-  if (inmap == NULL || outmap == NULL || p->map == NULL) {
+  p->mreg = malloc((nmap + 1) * sizeof *p->mreg);
+  p->melem = malloc((nmap + 1) * sizeof *p->melem);
+  if (inmap == NULL || outmap == NULL || p->mreg == NULL || p->melem == NULL) {
     free(inmap);
     free(outmap);
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   }
   const uint32_t *reg = dm_tape_outregs(p->tape);
-  for (size_t j = 0; j < nmap; j++)
-    p->map[j] = (struct dest){ reg[outmap[j].k], outmap[j].arr, outmap[j].elem };
-  p->nmap = nmap;
+  /* entries come array by array; in each, those to test first */
+  size_t cbase = dm_tape_nin(p->tape) + sp->npar, nc = dm_tape_nconst(p->tape);
+  uint8_t *seen = calloc(p->nregs + 1, 1);
+  if (seen == NULL) {
+    free(inmap);
+    free(outmap);
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  }
+  p->narr = 0;
+  for (size_t j = 0, e; j < nmap; j = e) {
+    uint32_t a = outmap[j].arr;
+    for (e = j; e < nmap && outmap[e].arr == a; e++)
+      ;
+    while (p->narr <= a)
+      p->ast[p->narr++] = (uint32_t)j;
+    size_t lo = j, hi = e;
+    for (size_t i = j; i < e; i++) {  /* tested entries up, others down */
+      uint32_t r = reg[outmap[i].k];
+      int untested = (r >= cbase && r < cbase + nc) || seen[r];
+      seen[r] = 1;
+      size_t at = untested ? --hi : lo++;
+      p->mreg[at] = r;
+      p->melem[at] = outmap[i].elem;
+    }
+    p->achk[a] = (uint32_t)lo;
+  }
+  free(seen);
+  p->ast[p->narr] = (uint32_t)nmap;
+  for (uint32_t a = 0; a < p->narr; a++)   /* arrays without entries */
+    if (p->ast[a] == p->ast[a + 1])
+      p->achk[a] = p->ast[a];
+  p->full = p->narr >= 32 ? ~0u : (1u << p->narr) - 1;
   if (sp->native == DM_NATIVE_NEVER) {
     free(inmap);
     free(outmap);

@@ -98,8 +98,11 @@ static void sb_printf(sbuf *b, const char *fmt, ...)
   }
 }
 
+/* writer[r] of the second result (the cosine of SINCOS, named u<i>) */
+#define SECOND ((size_t)1 << (sizeof(size_t) * 8 - 2))
+
 /* The C expression for register r; writer[r] = instruction that last
- * wrote the temporary r. */
+ * wrote the temporary r (| SECOND: its second result). */
 static void operand(char *buf, size_t size, const dm_tape *t, uint32_t r,
                     const size_t *writer, int mapped)
 {
@@ -118,7 +121,8 @@ static void operand(char *buf, size_t size, const dm_tape *t, uint32_t r,
     else
       snprintf(buf, size, "(%a)", c);
   } else {
-    snprintf(buf, size, "t%zu", writer[r]);
+    snprintf(buf, size, "%c%zu", writer[r] & SECOND ? 'u' : 't',
+             writer[r] & ~SECOND);
   }
 }
 
@@ -146,13 +150,74 @@ static const char prelude[] =
   "  while (u) {\n    if (u & 1)\n      r *= p;\n    u >>= 1;\n"
   "    if (u)\n      p *= p;\n  }\n  return n < 0 ? 1.0 / r : r;\n}\n"
   "static inline double dm_sign(double x)\n"
-  "{\n  return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;\n}\n";
+  "{\n  return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;\n}\n"
+  "#if defined(__GNUC__)\n#define DM_INLINE __attribute__((always_inline))\n"
+  "#else\n#define DM_INLINE\n#endif\n";
 
-/* The straight-line body: one local per instruction. */
-static void emit_body(sbuf *b, const dm_tape *t, size_t *writer, int mapped)
+/* An output store: output k to out[k] (arr < 0) or out[arr][elem], emitted
+ * right after instruction def computes it (def < 0: before the first). */
+typedef struct store {
+  long def;
+  uint32_t k, elem;
+  int arr;
+} store;
+
+static int cmp_store(const void *p, const void *q)
+{
+  const store *x = p, *y = q;
+  if (x->def != y->def)
+    return x->def < y->def ? -1 : 1;
+  return (x->k > y->k) - (x->k < y->k);   /* (stable: k, then position) */
+}
+
+/* def[k]: the instruction computing output k; -1 for inputs, parameters
+ * and constants (malloc'ed). */
+static long *output_defs(const dm_tape *t)
+{
+  size_t nregs = dm_tape_nregs(t), nout = dm_tape_nout(t);
+  size_t base = dm_tape_nin(t) + dm_tape_npar(t) + dm_tape_nconst(t);
+  size_t *w = calloc(nregs ? nregs : 1, sizeof *w);
+  long *def = malloc((nout ? nout : 1) * sizeof *def);
+  if (w == NULL || def == NULL) {
+    free(w);
+    free(def);
+    return NULL;
+  }
+  for (size_t i = 0; i < dm_tape_ninstr(t); i++) {
+    const dm_tape_ins *c = &dm_tape_code(t)[i];
+    w[c->d] = i;
+    if ((c->code & 0xff) == DM_T_SINCOS)
+      w[c->code >> 8] = i;
+  }
+  for (size_t k = 0; k < nout; k++) {
+    uint32_t r = dm_tape_outregs(t)[k];
+    def[k] = r >= base ? (long)w[r] : -1;
+  }
+  free(w);
+  return def;
+}
+
+static void emit_store(sbuf *b, const dm_tape *t, const store *st,
+                       const size_t *writer, int mapped)
+{
+  char x[64];
+  operand(x, sizeof x, t, dm_tape_outregs(t)[st->k], writer, mapped);
+  if (st->arr < 0)
+    sb_printf(b, "  out[%u] = %s;\n", st->k, x);
+  else
+    sb_printf(b, "  o%d[%u] = %s;\n", st->arr, st->elem, x);
+}
+
+/* The straight-line body: one local per instruction, each output stored
+ * as soon as it is computed (st[nst] sorted by def). */
+static void emit_body(sbuf *b, const dm_tape *t, size_t *writer, int mapped,
+                      const store *st, size_t nst)
 {
   const dm_tape_ins *code = dm_tape_code(t);
   char x[64], y[64], c[64];
+  size_t cur = 0;
+  for (; cur < nst && st[cur].def < 0; cur++)
+    emit_store(b, t, &st[cur], writer, mapped);
   for (size_t i = 0; i < dm_tape_ninstr(t) && !b->nomem; i++) {
     const dm_tape_ins *ip = &code[i];
     int op = (int)(ip->code & 0xff);
@@ -179,6 +244,10 @@ static void emit_body(sbuf *b, const dm_tape *t, size_t *writer, int mapped)
     case DM_T_MULSUB: sb_printf(b, "%s * %s - %s;\n", x, y, c); break;
     case DM_T_SUBMUL: sb_printf(b, "%s - %s * %s;\n", c, x, y); break;
     case DM_T_MUL3: sb_printf(b, "%s * %s * %s;\n", x, y, c); break;
+    case DM_T_SINCOS:       /* the compiler pairs them into one call */
+      sb_printf(b, "sin(%s);\n  const double u%zu = cos(%s);\n", x, i, x);
+      writer[ip->code >> 8] = i | SECOND;
+      break;
     default:
       if (c_infix[op] != NULL && op >= DM_T_LT)
         sb_printf(b, "(%s %s %s) ? 1.0 : 0.0;\n", x, c_infix[op], y);
@@ -189,45 +258,126 @@ static void emit_body(sbuf *b, const dm_tape *t, size_t *writer, int mapped)
       break;
     }
     writer[ip->d] = i;
+    for (; cur < nst && st[cur].def == (long)i; cur++)
+      emit_store(b, t, &st[cur], writer, mapped);
   }
 }
 
-/* dm_native_scatter: inputs gathered through inmap, every output checked
- * for NaN/Inf, then written to its destinations array by array (mask). */
-static void emit_scatter(sbuf *b, const dm_tape *t, size_t *writer,
-                         const dm_native_map *inmap, size_t nmap,
-                         const dm_native_map *outmap)
+/* The NaN/Inf test of the scatter body: the outputs summed in a balanced
+ * tree (one addition per output, no long dependency chain) are finite
+ * when every output is -- a finite sum of finite numbers can only
+ * overflow -- and only then is every output looked at (read back from
+ * where it was stored). */
+static void emit_check(sbuf *b, const dm_tape *t, size_t *writer,
+                       const store *first, size_t nout)
 {
   char x[64];
-  sb_printf(b, "\nint dm_native_scatter(const double *const *restrict in, "
-            "const double *restrict par, double *const *restrict out, "
-            "unsigned mask)\n{\n  (void)in; (void)par;\n");
+  size_t nv = 0, ns = 0;
+  char (*v)[64] = malloc((nout + 1) * sizeof *v);
+  if (v == NULL) {
+    b->nomem = 1;
+    return;
+  }
+  for (size_t k = 0; k < nout; k++) {
+    operand(x, sizeof x, t, dm_tape_outregs(t)[k], writer, 1);
+    if (x[0] == '(')
+      continue;                         /* a finite constant */
+    memcpy(v[nv++], x, sizeof x);
+  }
+  while (nv > 1) {
+    size_t m = 0;
+    for (size_t j = 0; j + 1 < nv; j += 2) {
+      sb_printf(b, "  const double s%zu = %s + %s;\n", ns, v[j], v[j + 1]);
+      snprintf(v[m++], sizeof v[0], "s%zu", ns++);
+    }
+    if (nv % 2)
+      memcpy(v[m++], v[nv - 1], sizeof v[0]);
+    nv = m;
+  }
+  if (nv == 1) {
+    sb_printf(b, "  if (!(%s <= DBL_MAX)) {\n    int bad = 0;\n", v[0]);
+    for (size_t k = 0; k < nout; k++) {
+      operand(x, sizeof x, t, dm_tape_outregs(t)[k], writer, 1);
+      if (x[0] == '(')
+        continue;
+      if (first[k].arr >= 0)
+        sb_printf(b, "    bad |= !(fabs(o%d[%u]) <= DBL_MAX);\n", first[k].arr,
+                  first[k].elem);
+      else
+        sb_printf(b, "    bad |= !(fabs(%s) <= DBL_MAX);\n", x);
+    }
+    sb_printf(b, "    return bad;\n  }\n");
+  }
+  free(v);
+  sb_printf(b, "  return 0;\n");
+}
+
+/* dm_native_scatter: inputs gathered through inmap, each output stored to
+ * its destinations as soon as it is computed, then the NaN/Inf test.  All
+ * arrays requested (the usual case): straight into them; else into a
+ * local buffer, then the requested ones copied. */
+static void emit_scatter(sbuf *b, const dm_tape *t, size_t *writer,
+                         const dm_native_map *inmap, size_t nmap,
+                         const dm_native_map *outmap, const long *def)
+{
+  size_t nout = dm_tape_nout(t);
+  store *st = malloc((nmap + 1) * sizeof *st);
+  store *first = malloc((nout + 1) * sizeof *first);
+  if (st == NULL || first == NULL) {
+    free(st);
+    free(first);
+    b->nomem = 1;
+    return;
+  }
+  uint32_t narr = 0, size[32] = { 0 }, off[32];
+  for (size_t k = 0; k < nout; k++)
+    first[k] = (store){ def[k], (uint32_t)k, 0, -1 };
+  for (size_t j = 0; j < nmap; j++) {
+    const dm_native_map *m = &outmap[j];
+    st[j] = (store){ def[m->k], m->k, m->elem, (int)m->arr };
+    if (first[m->k].arr < 0)
+      first[m->k] = st[j];
+    if (m->arr + 1 > narr)
+      narr = m->arr + 1;
+    if (m->elem + 1 > size[m->arr])
+      size[m->arr] = m->elem + 1;
+  }
+  qsort(st, nmap, sizeof *st, cmp_store);
+  sb_printf(b, "\nstatic inline DM_INLINE int dm_body(const double *const *restrict in, "
+            "const double *restrict par, double *const *restrict out)\n{\n"
+            "  (void)in; (void)par; (void)out;\n");
+  for (uint32_t a = 0; a < narr; a++)
+    sb_printf(b, "  double *restrict o%u = out[%u];\n", a, a);
   for (size_t i = 0; i < dm_tape_nin(t); i++)
     sb_printf(b, "  const double x%zu = in[%u][%u];\n", i, inmap[i].arr,
               inmap[i].elem);
-  emit_body(b, t, writer, 1);
-  const uint32_t *outreg = dm_tape_outregs(t);
-  sb_printf(b, "  int bad = 0;\n");
-  for (size_t k = 0; k < dm_tape_nout(t); k++) {
-    operand(x, sizeof x, t, outreg[k], writer, 1);
-    if (x[0] == 't' || x[0] == 'x' || x[0] == 'p')
-      sb_printf(b, "  bad |= !(fabs(%s) <= DBL_MAX);\n", x);
+  emit_body(b, t, writer, 1, st, nmap);
+  emit_check(b, t, writer, first, nout);
+  sb_printf(b, "}\n\nint dm_native_scatter(const double *const *restrict in, "
+            "const double *restrict par, double *const *restrict out, "
+            "unsigned mask)\n{\n");
+  uint32_t full = narr >= 32 ? ~0u : (1u << narr) - 1, total = 0;
+  for (uint32_t a = 0; a < narr; a++) {
+    off[a] = total;
+    total += size[a];
   }
-  sb_printf(b, "  if (bad)\n    return 1;\n");
-  uint32_t maxarr = 0;
-  for (size_t j = 0; j < nmap; j++)
-    if (outmap[j].arr > maxarr)
-      maxarr = outmap[j].arr;
-  for (uint32_t a = 0; a <= maxarr; a++) {
+  sb_printf(b, "  if ((mask & %uu) == %uu)\n    return dm_body(in, par, out);\n"
+            "  double buf[%u];\n  double *const o[%u] = {", full, full,
+            total ? total : 1, narr ? narr : 1);
+  for (uint32_t a = 0; a < narr; a++)
+    sb_printf(b, "%s buf + %u", a ? "," : "", off[a]);
+  sb_printf(b, "%s };\n  int r = dm_body(in, par, o);\n", narr ? "" : " buf");
+  for (uint32_t a = 0; a < narr; a++) {
     sb_printf(b, "  if (mask & %uu) {\n", 1u << a);
     for (size_t j = 0; j < nmap; j++)
-      if (outmap[j].arr == a) {
-        operand(x, sizeof x, t, outreg[outmap[j].k], writer, 1);
-        sb_printf(b, "    out[%u][%u] = %s;\n", a, outmap[j].elem, x);
-      }
+      if (outmap[j].arr == a)
+        sb_printf(b, "    out[%u][%u] = buf[%u];\n", a, outmap[j].elem,
+                  off[a] + outmap[j].elem);
     sb_printf(b, "  }\n");
   }
-  sb_printf(b, "  return 0;\n}\n");
+  sb_printf(b, "  return r;\n}\n");
+  free(st);
+  free(first);
 }
 
 /* The whole source: the flat function, and the scatter one when mapped. */
@@ -235,24 +385,29 @@ static char *emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
                   const dm_native_map *outmap)
 {
   sbuf b = { NULL, 0, 0, 0 };
-  size_t nregs = dm_tape_nregs(t);
+  size_t nregs = dm_tape_nregs(t), nout = dm_tape_nout(t);
   size_t *writer = calloc(nregs ? nregs : 1, sizeof *writer);
-  if (writer == NULL)
+  long *def = output_defs(t);
+  store *st = malloc((nout + 1) * sizeof *st);
+  if (writer == NULL || def == NULL || st == NULL) {
+    free(writer);
+    free(def);
+    free(st);
     return NULL;
-  char x[64];
+  }
+  for (size_t k = 0; k < nout; k++)
+    st[k] = (store){ def[k], (uint32_t)k, 0, -1 };
+  qsort(st, nout, sizeof *st, cmp_store);
   sb_printf(&b, "%s\nvoid dm_native_eval(const double *restrict in, "
             "const double *restrict par, double *restrict out)\n{\n"
             "  (void)in; (void)par;\n", prelude);
-  emit_body(&b, t, writer, 0);
-  const uint32_t *outreg = dm_tape_outregs(t);
-  for (size_t k = 0; k < dm_tape_nout(t); k++) {
-    operand(x, sizeof x, t, outreg[k], writer, 0);
-    sb_printf(&b, "  out[%zu] = %s;\n", k, x);
-  }
+  emit_body(&b, t, writer, 0, st, nout);
   sb_printf(&b, "}\n");
   if (inmap != NULL)
-    emit_scatter(&b, t, writer, inmap, nmap, outmap);
+    emit_scatter(&b, t, writer, inmap, nmap, outmap, def);
   free(writer);
+  free(def);
+  free(st);
   if (b.nomem) {
     free(b.s);
     return NULL;

@@ -2,8 +2,14 @@
  *
  * dm_native_compile emits straight-line C for a tape (one local double per
  * instruction, the same operations in the same order, so results agree with
- * the tape to the last bit in practice), compiles it with $CC (else "cc")
- * `-O2 -fPIC -shared -ffp-contract=off` in a private mkdtemp directory
+ * the tape to the last bit in practice; each output stored as soon as it
+ * is computed), compiles it with $CC (else "cc")
+ * `-O1 -fPIC -shared -ffp-contract=off -fno-math-errno` (-O1: straight-line
+ * code of a few hundred temporaries runs faster than at -O2 or -O3 --
+ * less register pressure -- and compiles sooner; -fno-math-errno lets
+ * sqrt be one instruction and pairs sin/cos of one argument into sincos;
+ * no -ffast-math: results equal the tape's bit for bit) in a private
+ * mkdtemp directory
  * (mode 0700) under $TMPDIR (else /tmp), loads it with dlopen and checks it
  * against the tape on random points (relative agreement 1e-15, NaN equal to
  * NaN).  Objects are cached under $XDG_CACHE_HOME/dmech (else
@@ -59,9 +65,12 @@ typedef struct dm_native_map {
 
 /* Gathers its inputs and scatters its outputs itself: input i is
  * in[inmap[i].arr][inmap[i].elem]; output k goes to out[arr][elem] for
- * every outmap entry with that k whose bit (1 << arr) is set in mask.
- * Returns 1, writing nothing, when any output is NaN or infinite, else 0.
- * This is what a system callback needs without copying through buffers. */
+ * every outmap entry with that k whose bit (1 << arr) is set in mask
+ * (arrays whose bit is clear are not touched and may be NULL).  Returns 1
+ * when any output is NaN or infinite (the requested arrays are then
+ * partly written), else 0.  This is what a system callback needs without
+ * copying through buffers: when every mapped array is requested, each
+ * output goes straight to its places as soon as it is computed. */
 typedef int (*dm_native_scatter_fn)(const double *const *in, const double *par,
                                     double *const *out, unsigned mask);
 

@@ -5,7 +5,7 @@
 
 #include "native.h"
 
-#define CC_FLAGS "-O2 -fPIC -shared -ffp-contract=off"
+#define CC_FLAGS "-O1 -fPIC -shared -ffp-contract=off -fno-math-errno"
 
 /* Split a compiler command at blanks into argv[0..k) (copy is modified). */
 int dm_native__cc_words(char *copy, char **argv, int max);

@@ -16,6 +16,7 @@ void dm_tape_free(dm_tape *t)
   if (t == NULL)
     return;
   free(t->code);
+  free(t->xcode);
   free(t->consts);
   free(t->outreg);
   free(t);
@@ -46,7 +47,7 @@ const char *dm_tape_op_name(int op)
     "add", "sub", "mul", "div", "neg", "sqr", "cube", "recip", "powi", "pow",
     "atan2", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos",
     "atan", "sinh", "cosh", "tanh", "abs", "sign", "lt", "le", "gt", "ge",
-    "eq", "ne", "select", "muladd", "mulsub", "submul", "mul3"
+    "eq", "ne", "select", "muladd", "mulsub", "submul", "mul3", "sincos"
   };
   return (op >= 0 && op < DM_T_NOPS) ? names[op] : "?";
 }
@@ -136,6 +137,7 @@ static int check_vars(dm_expr_ctx *ctx, size_t nin, const dm_expr *in,
 typedef struct plan {
   int op;
   int32_t pos, opnd[3], imm;
+  int32_t pos2;         /* SINCOS: the position of the cosine, else -1 */
 } plan;
 
 typedef struct build {
@@ -178,6 +180,7 @@ static void plan_node(const dm_expr_ctx *ctx, build *b, long p)
   int k = dm_expr__arity(nd.op);
   int32_t ops[3] = { nd.a, nd.b, nd.c };
   pl->pos = (int32_t)p;
+  pl->pos2 = -1;
   pl->imm = nd.op == DM_EXPR_POWI ? nd.b : 0;
   pl->opnd[0] = pl->opnd[1] = pl->opnd[2] = -1;
   for (int j = 0; j < k; j++)
@@ -212,11 +215,37 @@ static void plan_node(const dm_expr_ctx *ctx, build *b, long p)
   b->planned[p] = (int32_t)b->nplans++;
 }
 
+/* sin(x) and cos(x) both planned: one SINCOS where the first of them is
+ * (the other deleted). */
+static void pair_sincos(build *b)
+{
+  for (size_t k = 0; k < b->nplans; k++) {
+    plan *pk = &b->plans[k];
+    if (pk->op != DM_T_SIN && pk->op != DM_T_COS)
+      continue;
+    int want = pk->op == DM_T_SIN ? DM_T_COS : DM_T_SIN;
+    for (size_t j = k + 1; j < b->nplans; j++) {
+      plan *pj = &b->plans[j];
+      if (pj->op != want || pj->opnd[0] != pk->opnd[0])
+        continue;
+      int32_t ps = pk->op == DM_T_SIN ? pk->pos : pj->pos;
+      int32_t pc = pk->op == DM_T_SIN ? pj->pos : pk->pos;
+      pk->op = DM_T_SINCOS;
+      pk->pos = ps;
+      pk->pos2 = pc;
+      b->planned[ps] = (int32_t)k;
+      b->planned[pc] = -1;
+      pj->op = DM_T_NOPS;
+      break;
+    }
+  }
+}
+
 /* Temporaries by liveness: an operand's register is free after its last
  * reading, so d may equal an operand (every op reads before writing). */
 static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
 {
-  int32_t *freel = malloc((t->ninstr + 1) * sizeof *freel);
+  int32_t *freel = malloc((2 * t->ninstr + 2) * sizeof *freel);
   if (freel == NULL)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   size_t nfree = 0, ntmp = 0, i = 0;
@@ -240,6 +269,10 @@ static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
     b->reg[pl->pos] = d;
     dm_tape_ins *ins = &t->code[i++];
     ins->d = (uint32_t)d;
+    if (pl->pos2 >= 0) {                      /* SINCOS: the cosine */
+      r[2] = nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
+      b->reg[pl->pos2] = r[2];
+    }
     switch (pl->op) {
     case DM_T_SELECT:                         /* select(c, a, b) */
       ins->a = (uint32_t)r[1];
@@ -327,6 +360,7 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
   for (long p = 0; p < nl; p++)
     if (b->reg[p] == -1)
       plan_node(ctx, b, p);
+  pair_sincos(b);
   size_t nins = 0;
   for (size_t k = 0; k < b->nplans; k++) {
     if (b->plans[k].op == DM_T_NOPS)
@@ -385,6 +419,8 @@ static int compile_with(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
     memcpy(nw, out, nout * sizeof *nw);
   if (s == DM_OK)
     s = compile(ctx, t, &b, nout, nw, nin, in, npar, par, err);
+  if (s == DM_OK && dm_tape__thread(t) != DM_OK)
+    s = dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   free(nw);
   build_free(&b);
   if (s != DM_OK) {

@@ -51,12 +51,15 @@ enum dm_tape_op {
   DM_T_MULSUB,  /* r[a]*r[b] - r[c]          */
   DM_T_SUBMUL,  /* r[c] - r[a]*r[b]          */
   DM_T_MUL3,    /* (r[a]*r[b])*r[c]          */
+  /* sin and cos of one argument, one call: r[d] = sin(r[a]), r[c] =
+   * cos(r[a]) (c = code >> 8; the same values as sin and cos) */
+  DM_T_SINCOS,
   DM_T_NOPS
 };
 
 /* One instruction: op = code & 0xff; d, a, b registers (b is the exponent
  * for POWI); SELECT and the fused ops keep a third register c in
- * code >> 8. */
+ * code >> 8, SINCOS its second result register. */
 typedef struct dm_tape_ins {
   uint32_t code;
   uint32_t d, a, b;

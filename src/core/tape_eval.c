@@ -2,10 +2,12 @@
  *
  * One pass over a compact instruction array on a register file in the
  * caller's work buffer; no allocation, no calls through pointers.  With GNU
- * C the dispatch is threaded (a jump table of labels, one indirect jump per
- * instruction, which branch predictors follow far better than the single
- * jump of a switch; cross-jumping is off so that GCC does not merge the
- * dispatch tails back into one jump); otherwise it is a switch.
+ * C the dispatch is direct threaded (each instruction holds the address of
+ * its handler: one indirect jump per instruction, which branch predictors
+ * follow far better than the single jump of a switch; cross-jumping is off
+ * so that GCC does not merge the dispatch tails back into one jump; the
+ * code ends in a stop instruction, so there is no counter); otherwise it is
+ * a switch.
  * Floating-point contraction is off so that a*b + c rounds twice, exactly
  * as the DAG evaluator and the native code (-ffp-contract=off) do. */
 #include <config.h>
@@ -17,6 +19,8 @@
 #include "tape_impl.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 static inline double sign_of(double x)
@@ -24,59 +28,80 @@ static inline double sign_of(double x)
   return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;
 }
 
-/* The operation of every instruction, on scalars a, b, c (B: the second
- * register, C: the third, E: the POWI exponent). */
-#define DM_TAPE_OPS(X)                                  \
-  X(DM_T_ADD, a + B)                                    \
-  X(DM_T_SUB, a - B)                                    \
-  X(DM_T_MUL, a * B)                                    \
-  X(DM_T_DIV, a / B)                                    \
-  X(DM_T_NEG, -a)                                       \
-  X(DM_T_SQR, a * a)                                    \
-  X(DM_T_CUBE, a * (a * a))                             \
-  X(DM_T_RECIP, 1.0 / a)                                \
-  X(DM_T_POWI, dm_tape_powi(a, E))                      \
-  X(DM_T_POW, pow(a, B))                                \
-  X(DM_T_ATAN2, atan2(a, B))                            \
-  X(DM_T_SQRT, sqrt(a))                                 \
-  X(DM_T_EXP, exp(a))                                   \
-  X(DM_T_LOG, log(a))                                   \
-  X(DM_T_SIN, sin(a))                                   \
-  X(DM_T_COS, cos(a))                                   \
-  X(DM_T_TAN, tan(a))                                   \
-  X(DM_T_ASIN, asin(a))                                 \
-  X(DM_T_ACOS, acos(a))                                 \
-  X(DM_T_ATAN, atan(a))                                 \
-  X(DM_T_SINH, sinh(a))                                 \
-  X(DM_T_COSH, cosh(a))                                 \
-  X(DM_T_TANH, tanh(a))                                 \
-  X(DM_T_ABS, fabs(a))                                  \
-  X(DM_T_SIGN, sign_of(a))                              \
-  X(DM_T_LT, a < B)                                     \
-  X(DM_T_LE, a <= B)                                    \
-  X(DM_T_GT, a > B)                                     \
-  X(DM_T_GE, a >= B)                                    \
-  X(DM_T_EQ, a == B)                                    \
-  X(DM_T_NE, a != B)                                    \
-  X(DM_T_SELECT, C != 0 ? a : B)                        \
-  X(DM_T_MULADD, a * B + C)                             \
-  X(DM_T_MULSUB, a * B - C)                             \
-  X(DM_T_SUBMUL, C - a * B)                             \
-  X(DM_T_MUL3, a * B * C)
-
-static void load(const dm_tape *t, const double *in, const double *par,
-                 double *w)
+/* sin(x), storing cos(x) in *c: one call where the C library has one
+ * (glibc's sincos gives exactly sin(x) and cos(x)). */
+static inline double sin_cos(double x, double *c)
 {
-  if (t->nin && in != w)              /* in == w: inputs already in place */
-    memcpy(w, in, t->nin * sizeof *w);
-  if (t->npar)
-    memcpy(w + t->nin, par, t->npar * sizeof *w);
-  if (t->nconst)
-    memcpy(w + t->nin + t->npar, t->consts, t->nconst * sizeof *w);
+#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+  double s;
+  sincos(x, &s, c);
+  return s;
+#else
+  *c = cos(x);
+  return sin(x);
+#endif
 }
 
-#define B (w[ip->b])
-#define C (w[ip->code >> 8])
+/* The operation of every instruction on its operands A, B, C (E: the
+ * POWI exponent; CW: where SINCOS stores the cosine), by arity. */
+#define DM_TAPE_UNARY(X)                                \
+  X(DM_T_NEG, -A)                                       \
+  X(DM_T_SQR, A * A)                                    \
+  X(DM_T_CUBE, A * (A * A))                             \
+  X(DM_T_RECIP, 1.0 / A)                                \
+  X(DM_T_POWI, dm_tape_powi(A, E))                      \
+  X(DM_T_SQRT, sqrt(A))                                 \
+  X(DM_T_EXP, exp(A))                                   \
+  X(DM_T_LOG, log(A))                                   \
+  X(DM_T_SIN, sin(A))                                   \
+  X(DM_T_COS, cos(A))                                   \
+  X(DM_T_TAN, tan(A))                                   \
+  X(DM_T_ASIN, asin(A))                                 \
+  X(DM_T_ACOS, acos(A))                                 \
+  X(DM_T_ATAN, atan(A))                                 \
+  X(DM_T_SINH, sinh(A))                                 \
+  X(DM_T_COSH, cosh(A))                                 \
+  X(DM_T_TANH, tanh(A))                                 \
+  X(DM_T_ABS, fabs(A))                                  \
+  X(DM_T_SIGN, sign_of(A))                              \
+  X(DM_T_SINCOS, sin_cos(A, CW))
+#define DM_TAPE_BINARY(X)                               \
+  X(DM_T_ADD, A + B)                                    \
+  X(DM_T_SUB, A - B)                                    \
+  X(DM_T_MUL, A * B)                                    \
+  X(DM_T_DIV, A / B)                                    \
+  X(DM_T_POW, pow(A, B))                                \
+  X(DM_T_ATAN2, atan2(A, B))                            \
+  X(DM_T_LT, A < B)                                     \
+  X(DM_T_LE, A <= B)                                    \
+  X(DM_T_GT, A > B)                                     \
+  X(DM_T_GE, A >= B)                                    \
+  X(DM_T_EQ, A == B)                                    \
+  X(DM_T_NE, A != B)
+#define DM_TAPE_TERNARY(X)                              \
+  X(DM_T_SELECT, C != 0 ? A : B)                        \
+  X(DM_T_MULADD, A * B + C)                             \
+  X(DM_T_MULSUB, A * B - C)                             \
+  X(DM_T_SUBMUL, C - A * B)                             \
+  X(DM_T_MUL3, A * B * C)
+#define DM_TAPE_OPS(X) DM_TAPE_UNARY(X) DM_TAPE_BINARY(X) DM_TAPE_TERNARY(X)
+
+/* Parameters and constants into their registers (short: loops, not
+ * memcpy calls); inputs too unless they are there already. */
+static inline void load(const dm_tape *t, const double *in, const double *par,
+                        double *w)
+{
+  if (in != w)
+    for (size_t i = 0; i < t->nin; i++)
+      w[i] = in[i];
+  double *p = w + t->nin;
+  for (size_t i = 0; i < t->npar; i++)
+    p[i] = par[i];
+  p += t->npar;
+  for (size_t i = 0; i < t->nconst; i++)
+    p[i] = t->consts[i];
+}
+
 #define E ((int32_t)ip->b)
 
 void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
@@ -87,40 +112,157 @@ void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
     out[k] = w[t->outreg[k]];
 }
 
+/* Handlers come in variants by where the previous instruction's result
+ * is read: V0 all operands from registers; VA, VB, VC operand A, B or C
+ * straight from r (the value just computed), without the round trip
+ * through memory -- the store-to-load latency would otherwise sit on
+ * every dependency chain. */
+enum { V0, VA, VB, VC, NVAR };
+
+/* The loop over t->xcode, or (t == NULL) the handler addresses into
+ * labels[NVAR * DM_T_NOPS + 1] (op + variant * DM_T_NOPS; NULL where a
+ * variant does not exist; the last one stops). */
+static void run(const dm_tape *t, double *w, const void **labels)
+{
+#if defined(__GNUC__)
+#define LABEL0(o_, expr) [o_] = &&L0_##o_,
+#define LABELA(o_, expr) [VA * DM_T_NOPS + o_] = &&LA_##o_,
+#define LABELB(o_, expr) [VB * DM_T_NOPS + o_] = &&LB_##o_,
+#define LABELC(o_, expr) [VC * DM_T_NOPS + o_] = &&LC_##o_,
+  static const void *const jump[NVAR * DM_T_NOPS + 1] = {
+    DM_TAPE_OPS(LABEL0) DM_TAPE_OPS(LABELA)
+    DM_TAPE_BINARY(LABELB) DM_TAPE_TERNARY(LABELB) DM_TAPE_TERNARY(LABELC)
+    [NVAR * DM_T_NOPS] = &&L_halt
+  };
+#undef LABEL0
+#undef LABELA
+#undef LABELB
+#undef LABELC
+  if (t == NULL) {
+    memcpy(labels, jump, sizeof jump);
+    return;
+  }
+  /* each handler stores its result, loads the next instruction's first
+   * operand and jumps to its handler: one indirect jump per instruction,
+   * no counter (the last instruction stops) */
+  const dm_tape_xins *ip = t->xcode;
+  double a = w[ip->a], r = 0;
+  goto *ip->op;
+#define HANDLER(L, o_, expr)                            \
+  L##o_:                                                \
+    r = (expr);                                         \
+    w[ip->d] = r;                                       \
+    ip++;                                               \
+    a = w[ip->a];                                       \
+    goto *ip->op;
+#define CW (&w[ip->c])
+#define H0(o_, expr) HANDLER(L0_, o_, expr)
+#define HA(o_, expr) HANDLER(LA_, o_, expr)
+#define HB(o_, expr) HANDLER(LB_, o_, expr)
+#define HC(o_, expr) HANDLER(LC_, o_, expr)
+#define A a
+#define B (w[ip->b])
+#define C (w[ip->c])
+  DM_TAPE_OPS(H0)
+#undef A
+#define A r
+  DM_TAPE_OPS(HA)
+#undef A
+#undef B
+#define A a
+#define B r
+  DM_TAPE_BINARY(HB)
+  DM_TAPE_TERNARY(HB)
+#undef B
+#undef C
+#define B (w[ip->b])
+#define C r
+  DM_TAPE_TERNARY(HC)
+#undef A
+#undef B
+#undef C
+#undef H0
+#undef HA
+#undef HB
+#undef HC
+#undef HANDLER
+#undef CW
+L_halt:
+  return;
+#else
+  if (t == NULL) {                  /* every variant is its plain op */
+    for (int i = 0; i < NVAR * DM_T_NOPS; i++)
+      labels[i] = (const void *)(uintptr_t)(i % DM_T_NOPS);
+    labels[NVAR * DM_T_NOPS] = (const void *)(uintptr_t)DM_T_NOPS;
+    return;
+  }
+  for (const dm_tape_xins *ip = t->xcode; ; ip++) {
+    const double a = w[ip->a];
+    switch ((int)(uintptr_t)ip->op) {
+#define A a
+#define B (w[ip->b])
+#define C (w[ip->c])
+#define CW (&w[ip->c])
+#define CASE(o_, expr) case o_: w[ip->d] = (expr); break;
+      DM_TAPE_OPS(CASE)
+#undef CASE
+#undef A
+#undef B
+#undef C
+#undef CW
+    default:
+      return;
+    }
+  }
+#endif
+}
+
+/* The variant of instruction c given the register the previous one
+ * wrote (-1: none). */
+static int variant(const dm_tape_ins *c, int64_t prev)
+{
+  int op = (int)(c->code & 0xff);
+  if (prev < 0)
+    return V0;
+  if (c->a == prev)
+    return VA;
+  int binary = (op >= DM_T_ADD && op <= DM_T_DIV) || op == DM_T_POW ||
+               op == DM_T_ATAN2 || (op >= DM_T_LT && op <= DM_T_NE);
+  int ternary = op == DM_T_SELECT || (op >= DM_T_MULADD && op <= DM_T_MUL3);
+  if ((binary || ternary) && c->b == prev)
+    return VB;
+  if (ternary && (c->code >> 8) == prev)
+    return VC;
+  return V0;
+}
+
+int dm_tape__thread(dm_tape *t)
+{
+  const void *labels[NVAR * DM_T_NOPS + 1];
+  run(NULL, NULL, labels);
+  t->xcode = malloc((t->ninstr + 1) * sizeof *t->xcode);
+  if (t->xcode == NULL)
+    return DM_ENOMEM;
+  int64_t prev = -1;
+  for (size_t i = 0; i < t->ninstr; i++) {
+    const dm_tape_ins *c = &t->code[i];
+    int op = (int)(c->code & 0xff), v = variant(c, prev);
+    const void *h = labels[v * DM_T_NOPS + op];
+    if (h == NULL)
+      h = labels[op];
+    t->xcode[i] = (dm_tape_xins){ h, c->d, c->a, c->b, c->code >> 8 };
+    prev = c->d;
+  }
+  t->xcode[t->ninstr] = (dm_tape_xins){ labels[NVAR * DM_T_NOPS], 0, 0, 0, 0 };
+  return DM_OK;
+}
+
 void dm_tape_run(const dm_tape *t, const double *in, const double *par,
                  double *w)
 {
   load(t, in, par, w);
-  const dm_tape_ins *ip = t->code, *end = ip + t->ninstr;
-  if (ip < end) {
-#if defined(__GNUC__)
-#define LABEL(op, expr) [op] = &&L_##op,
-    static const void *const jump[DM_T_NOPS] = { DM_TAPE_OPS(LABEL) };
-#undef LABEL
-    double a = w[ip->a];
-    goto *jump[ip->code & 0xff];
-#define CASE(op, expr)                                  \
-  L_##op:                                               \
-    w[ip->d] = (expr);                                  \
-    if (++ip == end)                                    \
-      goto done;                                        \
-    a = w[ip->a];                                       \
-    goto *jump[ip->code & 0xff];
-    DM_TAPE_OPS(CASE)
-#undef CASE
-done:;
-#else
-    for (; ip < end; ip++) {
-      const double a = w[ip->a];
-      switch (ip->code & 0xff) {
-#define CASE(op, expr) case op: w[ip->d] = (expr); break;
-        DM_TAPE_OPS(CASE)
-#undef CASE
-      default: break;
-      }
-    }
-#endif
-  }
+  if (t->ninstr > 0)
+    run(t, w, NULL);
 }
 
 #undef B
@@ -132,8 +274,10 @@ done:;
  * loop the compiler vectorises
  * =================================================================== */
 
+#define A a
 #define B (b[j])
 #define C (c[j])
+#define CW (&c[j])
 #define E ((int32_t)ip->b)
 
 static void run_block(const dm_tape *t, double *W, size_t m)
@@ -144,7 +288,7 @@ static void run_block(const dm_tape *t, double *W, size_t m)
     double *d = W + (size_t)ip->d * R;
     const double *pa = W + (size_t)ip->a * R;
     const double *b = W + (size_t)(ip->b % t->nregs) * R;
-    const double *c = W + (size_t)(ip->code >> 8) * R;
+    double *c = W + (size_t)(ip->code >> 8) * R;
     switch (ip->code & 0xff) {
 #define CASE(op, expr)                                  \
     case op:                                            \
@@ -161,6 +305,8 @@ static void run_block(const dm_tape *t, double *W, size_t m)
   }
 }
 
+#undef CW
+#undef A
 #undef B
 #undef C
 #undef E

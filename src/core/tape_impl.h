@@ -7,12 +7,24 @@
 
 #define DM_TAPE_BATCH 32      /* points per block in batch evaluation */
 
+/* An instruction as the evaluation loop runs it (direct threading): the
+ * address of its handler (GNU C; else the op), the result register and up
+ * to three operand registers (b: the exponent for POWI). */
+typedef struct dm_tape_xins {
+  const void *op;
+  uint32_t d, a, b, c;
+} dm_tape_xins;
+
 struct dm_tape {
   size_t nin, npar, nconst, nout, ninstr, nregs;
   dm_tape_ins *code;
+  dm_tape_xins *xcode;      /* ninstr + 1: the last one stops */
   double *consts;
   uint32_t *outreg;
 };
+
+/* Fill t->xcode from t->code (allocated here; DM_ENOMEM). */
+int dm_tape__thread(dm_tape *t);
 
 /* Rewrite the outputs out[nout] for compiling (factored sums, shared
  * powers and reciprocals; tape_opt.c) into nw[nout], with nodes built
