@@ -263,9 +263,7 @@ local function panel_settings(what, o, dim, notitle)
   add(text_cmd(what, "xlabel", o.xlabel))
   add(text_cmd(what, "ylabel", o.ylabel))
   add(text_cmd(what, "zlabel", o.zlabel))
-  add(range_cmd(what, "x", o.xrange))
-  add(range_cmd(what, "y", o.yrange))
-  add(range_cmd(what, "z", o.zrange))
+  -- the scale before the ranges: a range is checked against the scale in force
   add("unset logscale\n")
   if o.logscale ~= nil then
     if type(o.logscale) ~= "string" or not o.logscale:match("^[xyz]+$") then
@@ -273,6 +271,9 @@ local function panel_settings(what, o, dim, notitle)
     end
     add("set logscale " .. o.logscale .. "\n")
   end
+  add(range_cmd(what, "x", o.xrange))
+  add(range_cmd(what, "y", o.yrange))
+  add(range_cmd(what, "z", o.zrange))
   add(o.grid and "set grid\n" or "unset grid\n")
   if o.key == false then
     add("unset key\n")
@@ -454,6 +455,9 @@ local function draw(what, opts, panels, layout, target)
       opts.title ~= nil and (" title " .. q(opts.title)) or ""))
   end
   for pi, p in ipairs(panels) do
+    -- inside a multiplot `reset` keeps the layout but clears what the
+    -- previous panel set, including its raw `commands`
+    if pi > 1 then gp.send("reset\n") end
     gp.send(settings[pi])
     if #items[pi] > 0 then
       gp.send((p.dim == 3 and "splot " or "plot ") .. table.concat(items[pi], ", ") .. "\n")

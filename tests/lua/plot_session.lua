@@ -150,4 +150,25 @@ T.ok(text:find("$dmp_1 << EOD\n1 3\n2.3849999999999998 4\nEOD\n", 1, true)
      and text:find("# dmech: checkpoint (dm.plot)", 1, true),
      "the log holds terminal, data, plot command and checkpoints")
 if res ~= "" then T.diag(res) end
+
+-- panels of a multiplot do not inherit each other's settings: a log scale
+-- and raw commands of panel 1 are gone in panel 2 (gnuplot prints no
+-- warning about a range on a log axis, and the log shows the reset)
+local log2 = dir .. "/panels.gp"
+os.remove(log2)
+local script = [[
+local x = dm.linspace(0.1, 3, 20)
+dm.plot{ {{x, x:map(math.exp)}, logscale = "y", commands = {"set format y '%.3f'"}},
+         {{x, x:map(math.sin)}, yrange = {-1, 1}}, layout = "1,2", output = "panels.png" }]]
+local cmd2 = "cd " .. H.shq(dir) .. " && DMECH_GNUPLOT_LOG=" .. H.shq(log2) .. " " ..
+  H.shq(os.getenv("DMECH")) .. " -e " .. H.shq(script) .. " 2>&1"
+local p2 = io.popen(cmd2)
+local out2 = p2:read("a")
+p2:close()
+local t2 = H.read(log2) or ""
+local second = t2:match("set format y '%%.3f'.-\nreset\n(.*)$") or ""
+T.ok(second:find("unset logscale", 1, true) and not second:find("\nset logscale", 1, true)
+     and not second:find("set format", 1, true) and second:find("set yrange [-1:1]", 1, true),
+     "panel 2 starts from a reset: no log scale, no raw commands of panel 1")
+T.ok(not out2:lower():find("warning"), "no gnuplot warning about ranges on a log axis: " .. out2)
 T.done()
