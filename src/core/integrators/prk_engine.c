@@ -68,6 +68,7 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
   P->sn = sn;
   P->nn = nn;
   P->forced = sys->force != NULL;
+  P->sep = (sys->flags & DM_SYS_SEPARABLE) && sys->mass != NULL && !P->forced;
   P->tol = tol;
   P->maxiter = maxiter;
   P->simplified = 1;
@@ -170,8 +171,10 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
   double *Qi = P->Q + i * n, *Vi = P->X + i * n;
   dm_lag_out o = {0, P->Lq + i * n, P->Lv + i * n, P->Lvv + i * nn, P->Lvq + i * nn,
                   P->Lqq + i * nn};
+  /* a separable L has Lvv = M (sys->mass, current parameters) and Lvq = 0:
+   * only Lqq is asked for with the Jacobian, and Lvq, Bm stay zero */
   unsigned what = DM_LAG_Q | DM_LAG_V | (want_L ? DM_LAG_L : 0u)
-                  | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
+                  | (jac ? (P->sep ? DM_LAG_QQ : (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ)) : 0u);
   int st = dm_eval_lag(P->sys, Qi, Vi, what, &o, P->work, e);
   if (st != DM_OK)
     return st;
@@ -183,6 +186,10 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
       const double *Lvq = P->Lvq + i * nn;
       double *Bm = P->Bm + i * nn;
       dm_vcopy(P->D + i * nn, P->Lqq + i * nn, nn);
+      if (P->sep) {
+        dm_vcopy(P->Lvv + i * nn, P->sys->mass, nn);
+        return DM_OK;
+      }
       for (a = 0; a < n; a++)
         for (b = 0; b < n; b++)
           Bm[a * n + b] = Lvq[b * n + a];
@@ -217,6 +224,7 @@ static void newton_matrix(dm_prk *P, double h, size_t N)
   const double *restrict Lvv = P->Lvv, *restrict Lvq = P->Lvq, *restrict Bm = P->Bm;
   const double *restrict D = P->D;
   double *restrict Jm = P->Jm, cj[DM_TABLEAU_SMAX];
+  const int sep = P->sep;       /* Lvq = Bm = 0 */
   size_t i, j, k, a, c;
   for (i = 0; i < s; i++)
     for (k = 0; k < s; k++) {
@@ -227,7 +235,7 @@ static void newton_matrix(dm_prk *P, double h, size_t N)
       for (a = 0; a < n; a++) {
         double *Jr = Jm + (i * n + a) * N + k * n;
         for (c = 0; c < n; c++) {
-          double v = hak * Lvqi[a * n + c] - hatk * Bmk[a * n + c];
+          double v = sep ? 0.0 : hak * Lvqi[a * n + c] - hatk * Bmk[a * n + c];
           if (i == k)
             v += Lvvi[a * n + c];
           for (j = 0; j < s; j++)

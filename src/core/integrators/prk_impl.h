@@ -20,6 +20,7 @@ struct dm_prk {
   dm_tableau *tab;             /* owned copy */
   size_t n, s, m, sn, nn;
   int forced;
+  int sep;                     /* separable and unforced: Lvv = M, Lvq = Bm = 0 */
   int explicit_sv;             /* explicit Stormer-Verlet / RATTLE */
   int distinct_nodes;          /* predictor may interpolate */
   double tol;
