@@ -142,6 +142,35 @@ dm_expr dm_expr__cons(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b, dm_expr c)
 /* The context's error status copied into err (DM_EFAILED if none). */
 int dm_expr__status(dm_expr_ctx *ctx, dm_err *err);
 
+/* Flattening into the element list ctx->nel[w] (expr_flat.c): sums (s a
+ * sign) collect their constant in c (hasc: bit src when operand src had
+ * one), products (exponent e) their coefficient in c and a constant
+ * divisor (1/d not exact) in d.  With merge, like elements are collected.
+ * Return -1 out of memory; products 1 when an exponent grows too large. */
+typedef struct dm_flat {
+  int w;
+  size_t n;
+  double c, d;
+  int hasc;
+} dm_flat;
+int dm_expr__flatten_sum(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int s,
+                         int src, int merge);
+int dm_expr__flatten_prod(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int64_t ex,
+                          int src, int merge);
+dm_nel *dm_expr__new_el(dm_expr_ctx *ctx, dm_flat *f);
+int dm_expr__grow(void *pp, size_t *cap, size_t need, size_t size);
+int dm_expr__isc(const dm_expr_ctx *ctx, dm_expr e, double *v);
+/* e is a sum (ADD, SUB, or negations of one). */
+int dm_expr__sumlike(const dm_expr_ctx *ctx, dm_expr e);
+/* Element hashes and the hash of a multiset from their sum; the normal
+ * node with these n elements (or DM_EXPR_NONE); remember one (-1 out of
+ * memory). */
+uint64_t dm_expr__hel(const dm_nel *x, int prod);
+uint64_t dm_expr__hfin(uint64_t s, size_t n, int prod);
+dm_expr dm_expr__probe(dm_expr_ctx *ctx, uint64_t h, int prod,
+                       const dm_nel *E, size_t n);
+int dm_expr__reg(dm_expr_ctx *ctx, uint64_t h, dm_expr e);
+
 /* The constant node x (as dm_expr_const). */
 dm_expr dm_expr__k(dm_expr_ctx *ctx, double x);
 /* Release the normal-form buffers and table (expr_norm.c). */

@@ -20,13 +20,12 @@ typedef struct prog {
   dm_native_fn fn;
   dm_native_scatter_fn scatter;   /* native, writing the caller's arrays */
   size_t nout, nregs;
-  /* tape path: output destinations, array by array: entries
-   * ast[a] .. ast[a+1] go to array a (register mreg[j] to element
-   * melem[j]), those from achk[a] on need no NaN/Inf test (constants,
-   * values tested at an earlier entry); full: the bits of every array */
-  uint32_t *mreg, *melem;
-  uint32_t narr, ast[33], achk[32];
-  unsigned full;
+  /* tape path: the outputs are laid out in the tape's slots (registers
+   * from slot0) exactly as in the arrays: array a is slots aoff[a] ..
+   * aoff[a+1] */
+  size_t slot0;
+  uint32_t narr, aoff[33];
+  uint32_t nchk, *chk;            /* the registers to test for NaN/Inf */
 } prog;
 
 typedef struct lag_data {
@@ -43,8 +42,7 @@ typedef struct lag_data {
 
 static void prog_free(prog *p)
 {
-  free(p->mreg);
-  free(p->melem);
+  free(p->chk);
   dm_native_free(p->nat);
   dm_tape_free(p->tape);
   memset(p, 0, sizeof *p);
@@ -98,37 +96,25 @@ static inline uint64_t nonfinite_bit(double x)
   return (u & 0x7ff0000000000000ULL) + 0x0010000000000000ULL;
 }
 
-/* The tape path of a callback: run on the inputs already in w, scatter the
- * outputs to the arrays of out[] whose bit is in mask, testing them on the
- * way.  Returns 1 when an output is NaN or Inf (the arrays are then partly
- * written): every output is tested, requested or not, as native code
- * does. */
+/* The tape path of a callback: run on the inputs already in w (its slots
+ * then hold the arrays' contents), test every output for NaN/Inf,
+ * requested or not, as native code does, copy the arrays whose bit is in
+ * mask.  Returns 1 (nothing written) when an output is NaN or Inf. */
 static int tape_scatter(const prog *p, double *w, const double *par,
                         double *const *out, unsigned mask)
 {
   dm_tape_run(p->tape, w, par, w);
+  const uint32_t *chk = p->chk, nchk = p->nchk;
   uint64_t bad = 0;
-  if ((mask & p->full) != p->full) {
-    const uint32_t *reg = dm_tape_outregs(p->tape);
-    for (size_t k = 0; k < p->nout; k++)
-      bad |= nonfinite_bit(w[reg[k]]);
-  }
-  const uint32_t *reg = p->mreg, *elem = p->melem;
-  const uint32_t narr = p->narr;
-  for (uint32_t a = 0; a < narr; a++) {
-    const uint32_t j0 = p->ast[a], jc = p->achk[a], j1 = p->ast[a + 1];
-    double *dst = out[a];
-    if (!(mask & (1u << a)))
-      continue;
-    for (uint32_t j = j0; j < jc; j++) {
-      double x = w[reg[j]];
-      bad |= nonfinite_bit(x);
-      dst[elem[j]] = x;
-    }
-    for (uint32_t j = jc; j < j1; j++)
-      dst[elem[j]] = w[reg[j]];
-  }
-  return (int)(bad >> 63);
+  for (uint32_t j = 0; j < nchk; j++)
+    bad |= nonfinite_bit(w[chk[j]]);
+  if (bad >> 63)
+    return 1;             /* outside the domain: retry with another step */
+  const double *v = w + p->slot0;
+  for (uint32_t a = 0; a < p->narr; a++)
+    if (mask & (1u << a))
+      dm_copy_doubles(out[a], v + p->aoff[a], p->aoff[a + 1] - p->aoff[a]);
+  return 0;
 }
 
 static inline void copy(double *dst, const double *src, size_t k)
@@ -273,55 +259,67 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
                         size_t nin, const block *blk, size_t nblk, int exact)
 {
   const dm_lagrangian_spec *sp = b->sp;
-  int s = (exact ? dm_tape_compile_exact : dm_tape_compile)(b->ctx, nout,
-          out, nin, b->in, sp->npar, sp->par, &p->tape, b->err);
-  if (s != DM_OK)
-    return s;
-  p->nout = nout;
-  p->nregs = dm_tape_work_size(p->tape);
   size_t nmap = 0, n = sp->n;
   dm_native_map *inmap = malloc((nin + 1) * sizeof *inmap);
   dm_native_map *outmap = make_outmap(blk, nblk, nout, &nmap);
-  p->mreg = malloc((nmap + 1) * sizeof *p->mreg);
-  p->melem = malloc((nmap + 1) * sizeof *p->melem);
-  if (inmap == NULL || outmap == NULL || p->mreg == NULL || p->melem == NULL) {
+  uint32_t *slot_out = malloc((nmap + 1) * sizeof *slot_out);
+  if (inmap == NULL || outmap == NULL || slot_out == NULL) {
     free(inmap);
     free(outmap);
+    free(slot_out);
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   }
-  const uint32_t *reg = dm_tape_outregs(p->tape);
-  /* entries come array by array; in each, those to test first */
-  size_t cbase = dm_tape_nin(p->tape) + sp->npar, nc = dm_tape_nconst(p->tape);
-  uint8_t *seen = calloc(p->nregs + 1, 1);
-  if (seen == NULL) {
-    free(inmap);
-    free(outmap);
-    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
-  }
+  /* the arrays laid out one after the other in the tape's slots (the
+   * blocks fill their arrays densely) */
+  uint32_t size[32] = { 0 };
   p->narr = 0;
-  for (size_t j = 0, e; j < nmap; j = e) {
+  for (size_t j = 0; j < nmap; j++) {
     uint32_t a = outmap[j].arr;
-    for (e = j; e < nmap && outmap[e].arr == a; e++)
-      ;
-    while (p->narr <= a)
-      p->ast[p->narr++] = (uint32_t)j;
-    size_t lo = j, hi = e;
-    for (size_t i = j; i < e; i++) {  /* tested entries up, others down */
-      uint32_t r = reg[outmap[i].k];
-      int untested = (r >= cbase && r < cbase + nc) || seen[r];
-      seen[r] = 1;
-      size_t at = untested ? --hi : lo++;
-      p->mreg[at] = r;
-      p->melem[at] = outmap[i].elem;
-    }
-    p->achk[a] = (uint32_t)lo;
+    if (a + 1 > p->narr)
+      p->narr = a + 1;
+    if (outmap[j].elem + 1 > size[a])
+      size[a] = outmap[j].elem + 1;
   }
-  free(seen);
-  p->ast[p->narr] = (uint32_t)nmap;
-  for (uint32_t a = 0; a < p->narr; a++)   /* arrays without entries */
-    if (p->ast[a] == p->ast[a + 1])
-      p->achk[a] = p->ast[a];
-  p->full = p->narr >= 32 ? ~0u : (1u << p->narr) - 1;
+  p->aoff[0] = 0;
+  for (uint32_t a = 0; a < p->narr; a++)
+    p->aoff[a + 1] = p->aoff[a] + size[a];
+  int s = p->aoff[p->narr] == nmap ? DM_OK
+          : dm_err_set(b->err, DM_EFAILED, "internal: output blocks leave gaps");
+  for (size_t j = 0; j < nmap; j++)
+    slot_out[p->aoff[outmap[j].arr] + outmap[j].elem] = outmap[j].k;
+  if (s == DM_OK && nmap > 0)
+    s = dm_tape_compile_slots(b->ctx, nout, out, nin, b->in, sp->npar,
+                              sp->par, nmap, slot_out, &p->tape, b->err);
+  else if (s == DM_OK)
+    s = (exact ? dm_tape_compile_exact : dm_tape_compile)(b->ctx, nout,
+        out, nin, b->in, sp->npar, sp->par, &p->tape, b->err);
+  free(slot_out);
+  if (s != DM_OK) {
+    free(inmap);
+    free(outmap);
+    return s;
+  }
+  p->nout = nout;
+  p->nregs = dm_tape_work_size(p->tape);
+  p->slot0 = dm_tape_slot_base(p->tape);
+  /* the distinct output registers that are not constants */
+  const uint32_t *oreg = dm_tape_outregs(p->tape);
+  size_t c0 = dm_tape_nin(p->tape) + dm_tape_npar(p->tape);
+  size_t c1 = c0 + dm_tape_nconst(p->tape);
+  p->chk = malloc((nout + 1) * sizeof *p->chk);
+  if (p->chk == NULL) {
+    free(inmap);
+    free(outmap);
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  }
+  p->nchk = 0;
+  for (size_t k = 0; k < nout; k++) {
+    int dup = oreg[k] >= c0 && oreg[k] < c1;
+    for (uint32_t j = 0; j < p->nchk && !dup; j++)
+      dup = p->chk[j] == oreg[k];
+    if (!dup)
+      p->chk[p->nchk++] = oreg[k];
+  }
   if (sp->native == DM_NATIVE_NEVER) {
     free(inmap);
     free(outmap);

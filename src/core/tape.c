@@ -17,6 +17,8 @@ void dm_tape_free(dm_tape *t)
     return;
   free(t->code);
   free(t->xcode);
+  free(t->copy);
+  free(t->preset);
   free(t->consts);
   free(t->outreg);
   free(t);
@@ -30,6 +32,7 @@ size_t dm_tape_nin(const dm_tape *t) { return t->nin; }
 size_t dm_tape_npar(const dm_tape *t) { return t->npar; }
 size_t dm_tape_nout(const dm_tape *t) { return t->nout; }
 size_t dm_tape_nconst(const dm_tape *t) { return t->nconst; }
+size_t dm_tape_slot_base(const dm_tape *t) { return t->slot0; }
 const dm_tape_ins *dm_tape_code(const dm_tape *t) { return t->code; }
 const double *dm_tape_consts(const dm_tape *t) { return t->consts; }
 const uint32_t *dm_tape_outregs(const dm_tape *t) { return t->outreg; }
@@ -147,6 +150,7 @@ typedef struct build {
   int32_t *last;        /* per position: last instruction reading it */
   int32_t *uses;        /* per position: readers (outputs count) */
   int32_t *planned;     /* per position: index into plans, -1 none */
+  int32_t *slotreg;     /* per position: its output slot's register, or -1 */
   plan *plans;
   size_t nplans;
 } build;
@@ -158,6 +162,7 @@ static void build_free(build *b)
   free(b->last);
   free(b->uses);
   free(b->planned);
+  free(b->slotreg);
   free(b->plans);
 }
 
@@ -242,7 +247,9 @@ static void pair_sincos(build *b)
 }
 
 /* Temporaries by liveness: an operand's register is free after its last
- * reading, so d may equal an operand (every op reads before writing). */
+ * reading, so d may equal an operand (every op reads before writing).
+ * Registers from base on are temporaries; a result with an output slot
+ * goes to the slot's register (below base), never freed. */
 static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
 {
   int32_t *freel = malloc((2 * t->ninstr + 2) * sizeof *freel);
@@ -265,12 +272,14 @@ static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
       if (b->last[q] == (int32_t)i && (size_t)r[j] >= base && !dup)
         freel[nfree++] = r[j];
     }
-    int32_t d = nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
+    int32_t d = b->slotreg[pl->pos] >= 0 ? b->slotreg[pl->pos]
+                : nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
     b->reg[pl->pos] = d;
     dm_tape_ins *ins = &t->code[i++];
     ins->d = (uint32_t)d;
     if (pl->pos2 >= 0) {                      /* SINCOS: the cosine */
-      r[2] = nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
+      r[2] = b->slotreg[pl->pos2] >= 0 ? b->slotreg[pl->pos2]
+             : nfree > 0 ? freel[--nfree] : (int32_t)(base + ntmp++);
       b->reg[pl->pos2] = r[2];
     }
     switch (pl->op) {
@@ -301,7 +310,8 @@ static int assign_registers(dm_tape *t, build *b, size_t base, dm_err *err)
 
 static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
                    const dm_expr *out, size_t nin, const dm_expr *in,
-                   size_t npar, const dm_expr *par, dm_err *err)
+                   size_t npar, const dm_expr *par, size_t nslot,
+                   const uint32_t *slot_out, dm_err *err)
 {
   long nl = dm_expr__collect(ctx, nout, out);
   if (nl < 0)
@@ -313,11 +323,12 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
   b->last = malloc(sz * sizeof *b->last);
   b->uses = calloc(sz, sizeof *b->uses);
   b->planned = malloc(sz * sizeof *b->planned);
+  b->slotreg = malloc(sz * sizeof *b->slotreg);
   b->plans = malloc(sz * sizeof *b->plans);
   t->consts = malloc(sz * sizeof *t->consts);
   t->outreg = malloc((nout ? nout : 1) * sizeof *t->outreg);
   if (!b->list || !b->reg || !b->last || !b->uses || !b->planned ||
-      !b->plans || !t->consts || !t->outreg)
+      !b->slotreg || !b->plans || !t->consts || !t->outreg)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   memcpy(b->list, ctx->list, sz * sizeof *b->list);
   const uint32_t ep = ctx->epoch;
@@ -336,6 +347,7 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
     b->last[p] = -1;
     b->reg[p] = -1;
     b->planned[p] = -1;
+    b->slotreg[p] = -1;
     if (ctx->aux[x] <= -2) {
       b->reg[p] = -2 - ctx->aux[x];
     } else if (nd.op == DM_EXPR_CONST) {
@@ -376,17 +388,44 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
       b->reg[p] = (int32_t)(nin + npar) + (-3 - b->reg[p]);
   for (size_t k = 0; k < nout; k++)
     b->last[ctx->aux[out[k]]] = INT32_MAX;      /* outputs live to the end */
+  /* output slots: a computed output goes straight to its first slot; the
+   * other slots (and outputs that are inputs, parameters or constants)
+   * are copied at the end of a run */
+  size_t ncopy = 0;
+  for (size_t sl = 0; sl < nslot; sl++) {
+    int32_t p = ctx->aux[out[slot_out[sl]]];
+    if (b->reg[p] == -1 && b->slotreg[p] < 0)
+      b->slotreg[p] = (int32_t)(base + sl);
+    else
+      ncopy++;
+  }
   t->nin = nin;
   t->npar = npar;
   t->nconst = ncon;
   t->nout = nout;
   t->ninstr = nins;
+  t->nslot = nslot;
+  t->slot0 = base;
   t->code = malloc((nins ? nins : 1) * sizeof *t->code);
-  if (t->code == NULL)
+  t->copy = malloc((ncopy ? ncopy : 1) * sizeof *t->copy);
+  t->preset = calloc(ncon + nslot + 1, sizeof *t->preset);
+  if (t->code == NULL || t->copy == NULL || t->preset == NULL)
     return dm_err_set(err, DM_ENOMEM, "tape: out of memory");
-  int s = assign_registers(t, b, base, err);
+  memcpy(t->preset, t->consts, ncon * sizeof *t->preset);
+  int s = assign_registers(t, b, base + nslot, err);
   if (s != DM_OK)
     return s;
+  for (size_t sl = 0; sl < nslot; sl++) {  /* constants: preset, else copies */
+    int32_t p = ctx->aux[out[slot_out[sl]]], r = b->reg[p];
+    if (r == (int32_t)(base + sl))
+      continue;
+    if (r >= (int32_t)(nin + npar) && r < (int32_t)base) {
+      t->preset[ncon + sl] = t->consts[r - (int32_t)(nin + npar)];
+      continue;
+    }
+    t->copy[t->ncopy][0] = (uint32_t)(base + sl);
+    t->copy[t->ncopy++][1] = (uint32_t)r;
+  }
   for (size_t k = 0; k < nout; k++)
     t->outreg[k] = (uint32_t)b->reg[ctx->aux[out[k]]];
   return DM_OK;
@@ -394,7 +433,8 @@ static int compile(dm_expr_ctx *ctx, dm_tape *t, build *b, size_t nout,
 
 static int compile_with(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
                         size_t nin, const dm_expr *in, size_t npar,
-                        const dm_expr *par, int rewrite, dm_tape **tape,
+                        const dm_expr *par, int rewrite, size_t nslot,
+                        const uint32_t *slot_out, dm_tape **tape,
                         dm_err *err)
 {
   *tape = NULL;
@@ -405,9 +445,13 @@ static int compile_with(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
   int s = check_vars(ctx, nin, in, npar, par, err);
   if (s != DM_OK)
     return s;
+  for (size_t sl = 0; sl < nslot; sl++)
+    if (slot_out[sl] >= nout)
+      return dm_err_set(err, DM_EINVAL, "tape: slot %zu names output %u of "
+                        "%zu", sl + 1, slot_out[sl] + 1, nout);
   dm_tape *t = calloc(1, sizeof *t);
   dm_expr *nw = malloc((nout ? nout : 1) * sizeof *nw);
-  build b = { 0, NULL, NULL, NULL, NULL, NULL, NULL, 0 };
+  build b = { 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, 0 };
   if (t == NULL || nw == NULL) {
     free(t);
     free(nw);
@@ -418,7 +462,8 @@ static int compile_with(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
   else
     memcpy(nw, out, nout * sizeof *nw);
   if (s == DM_OK)
-    s = compile(ctx, t, &b, nout, nw, nin, in, npar, par, err);
+    s = compile(ctx, t, &b, nout, nw, nin, in, npar, par, nslot, slot_out,
+                err);
   if (s == DM_OK && dm_tape__thread(t) != DM_OK)
     s = dm_err_set(err, DM_ENOMEM, "tape: out of memory");
   free(nw);
@@ -435,14 +480,26 @@ int dm_tape_compile(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
                     size_t nin, const dm_expr *in, size_t npar,
                     const dm_expr *par, dm_tape **tape, dm_err *err)
 {
-  return compile_with(ctx, nout, out, nin, in, npar, par, 1, tape, err);
+  return compile_with(ctx, nout, out, nin, in, npar, par, 1, 0, NULL, tape,
+                      err);
 }
 
 int dm_tape_compile_exact(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
                           size_t nin, const dm_expr *in, size_t npar,
                           const dm_expr *par, dm_tape **tape, dm_err *err)
 {
-  return compile_with(ctx, nout, out, nin, in, npar, par, 0, tape, err);
+  return compile_with(ctx, nout, out, nin, in, npar, par, 0, 0, NULL, tape,
+                      err);
+}
+
+int dm_tape_compile_slots(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                          size_t nin, const dm_expr *in, size_t npar,
+                          const dm_expr *par, size_t nslot,
+                          const uint32_t *slot_out, dm_tape **tape,
+                          dm_err *err)
+{
+  return compile_with(ctx, nout, out, nin, in, npar, par, 0, nslot, slot_out,
+                      tape, err);
 }
 
 int dm_tape_optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,

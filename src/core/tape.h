@@ -26,6 +26,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "expr.h"
 #include "status.h"
@@ -86,6 +87,19 @@ int dm_tape_optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
 int dm_tape_compile_exact(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
                           size_t nin, const dm_expr *in, size_t npar,
                           const dm_expr *par, dm_tape **tape, dm_err *err);
+/* dm_tape_compile_exact with the outputs also laid out in nslot
+ * consecutive registers from dm_tape_slot_base(t): after a run, register
+ * base + s holds output slot_out[s] (an output may fill several slots;
+ * DM_EINVAL for slot_out[s] >= nout).  An output is computed straight into
+ * its first slot; the other slots are copied at the end of a run (a short
+ * loop, not instructions).  Callers that store outputs in arrays
+ * (mirrored matrices, say) then copy whole blocks. */
+int dm_tape_compile_slots(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
+                          size_t nin, const dm_expr *in, size_t npar,
+                          const dm_expr *par, size_t nslot,
+                          const uint32_t *slot_out, dm_tape **tape,
+                          dm_err *err);
+size_t dm_tape_slot_base(const dm_tape *t);
 
 /* out[nout] = outputs at (in[nin], par[npar]); work has dm_tape_work_size
  * doubles.  in / par may be NULL when nin / npar is 0.  in may be work
@@ -120,6 +134,22 @@ const uint32_t *dm_tape_outregs(const dm_tape *t);    /* nout registers */
 /* Number of instructions with each op (counts[DM_T_NOPS]). */
 void dm_tape_op_counts(const dm_tape *t, size_t *counts);
 const char *dm_tape_op_name(int op);
+
+/* dst[0..n) = src[0..n) (not overlapping): short ones inline, two
+ * doubles at a time, long ones by memcpy (for callers that copy a few
+ * outputs per evaluation). */
+static inline void dm_copy_doubles(double *dst, const double *src, size_t n)
+{
+  if (n > 32) {
+    memcpy(dst, src, n * sizeof *dst);
+    return;
+  }
+  size_t i = 0;
+  for (; i + 2 <= n; i += 2)
+    memcpy(dst + i, src + i, 2 * sizeof *dst);
+  if (i < n)
+    dst[i] = src[i];
+}
 
 /* x^n exactly as DM_T_POWI computes it (binary powering). */
 static inline double dm_tape_powi(double x, int n)

@@ -86,8 +86,8 @@ static inline double sin_cos(double x, double *c)
   X(DM_T_MUL3, A * B * C)
 #define DM_TAPE_OPS(X) DM_TAPE_UNARY(X) DM_TAPE_BINARY(X) DM_TAPE_TERNARY(X)
 
-/* Parameters and constants into their registers (short: loops, not
- * memcpy calls); inputs too unless they are there already. */
+/* Parameters, constants and constant outputs into their registers;
+ * inputs too unless they are there already. */
 static inline void load(const dm_tape *t, const double *in, const double *par,
                         double *w)
 {
@@ -98,8 +98,7 @@ static inline void load(const dm_tape *t, const double *in, const double *par,
   for (size_t i = 0; i < t->npar; i++)
     p[i] = par[i];
   p += t->npar;
-  for (size_t i = 0; i < t->nconst; i++)
-    p[i] = t->consts[i];
+  dm_copy_doubles(p, t->preset, t->nconst + t->nslot);
 }
 
 #define E ((int32_t)ip->b)
@@ -119,9 +118,34 @@ void dm_tape_eval(const dm_tape *t, const double *in, const double *par,
  * every dependency chain. */
 enum { V0, VA, VB, VC, NVAR };
 
+/* Pairs: two consecutive instructions of these ops, the second not reading
+ * the first's result, run by one handler (one dispatch for two; the second
+ * takes its operands from registers, A2, B2, C2).  The first one's
+ * variant as above. */
+#define DM_TAPE_PAIR2(M, v, x, ex)                                    \
+  M(v, x, ex, MUL, A2 * B2) M(v, x, ex, MULADD, A2 * B2 + C2)         \
+  M(v, x, ex, MULSUB, A2 * B2 - C2) M(v, x, ex, MUL3, A2 * B2 * C2)   \
+  M(v, x, ex, ADD, A2 + B2) M(v, x, ex, SUB, A2 - B2)                 \
+  M(v, x, ex, SQR, A2 * A2)
+#define DM_TAPE_PAIRS(M, v)                                           \
+  DM_TAPE_PAIR2(M, v, MUL, A * B) DM_TAPE_PAIR2(M, v, MULADD, A * B + C) \
+  DM_TAPE_PAIR2(M, v, MULSUB, A * B - C)                              \
+  DM_TAPE_PAIR2(M, v, MUL3, A * B * C) DM_TAPE_PAIR2(M, v, ADD, A + B) \
+  DM_TAPE_PAIR2(M, v, SUB, A - B) DM_TAPE_PAIR2(M, v, SQR, A * A)
+enum { P_MUL, P_MULADD, P_MULSUB, P_MUL3, P_ADD, P_SUB, P_SQR, NPAIR };
+/* 1 + the pair index of an op, 0 when it does not pair */
+static const signed char pair_index[DM_T_NOPS] = {
+  [DM_T_MUL] = 1 + P_MUL, [DM_T_MULADD] = 1 + P_MULADD,
+  [DM_T_MULSUB] = 1 + P_MULSUB, [DM_T_MUL3] = 1 + P_MUL3,
+  [DM_T_ADD] = 1 + P_ADD, [DM_T_SUB] = 1 + P_SUB, [DM_T_SQR] = 1 + P_SQR
+};
+#define PAIR_BASE (NVAR * DM_T_NOPS + 1)
+#define NLABELS (PAIR_BASE + NVAR * NPAIR * NPAIR)
+#define PAIR_AT(v, x, y) (PAIR_BASE + ((v) * NPAIR + (x)) * NPAIR + (y))
+
 /* The loop over t->xcode, or (t == NULL) the handler addresses into
- * labels[NVAR * DM_T_NOPS + 1] (op + variant * DM_T_NOPS; NULL where a
- * variant does not exist; the last one stops). */
+ * labels[NLABELS]: op + variant * DM_T_NOPS (NULL where a variant does
+ * not exist), then the stop, then the pairs at PAIR_AT (GNU C only). */
 static void run(const dm_tape *t, double *w, const void **labels)
 {
 #if defined(__GNUC__)
@@ -129,15 +153,19 @@ static void run(const dm_tape *t, double *w, const void **labels)
 #define LABELA(o_, expr) [VA * DM_T_NOPS + o_] = &&LA_##o_,
 #define LABELB(o_, expr) [VB * DM_T_NOPS + o_] = &&LB_##o_,
 #define LABELC(o_, expr) [VC * DM_T_NOPS + o_] = &&LC_##o_,
-  static const void *const jump[NVAR * DM_T_NOPS + 1] = {
+#define LABELP(v, x, ex, y, ey) [PAIR_AT(v, P_##x, P_##y)] = &&LP##v##_##x##_##y,
+  static const void *const jump[NLABELS] = {
     DM_TAPE_OPS(LABEL0) DM_TAPE_OPS(LABELA)
     DM_TAPE_BINARY(LABELB) DM_TAPE_TERNARY(LABELB) DM_TAPE_TERNARY(LABELC)
-    [NVAR * DM_T_NOPS] = &&L_halt
+    [NVAR * DM_T_NOPS] = &&L_halt,
+    DM_TAPE_PAIRS(LABELP, V0) DM_TAPE_PAIRS(LABELP, VA)
+    DM_TAPE_PAIRS(LABELP, VB) DM_TAPE_PAIRS(LABELP, VC)
   };
 #undef LABEL0
 #undef LABELA
 #undef LABELB
 #undef LABELC
+#undef LABELP
   if (t == NULL) {
     memcpy(labels, jump, sizeof jump);
     return;
@@ -160,27 +188,46 @@ static void run(const dm_tape *t, double *w, const void **labels)
 #define HA(o_, expr) HANDLER(LA_, o_, expr)
 #define HB(o_, expr) HANDLER(LB_, o_, expr)
 #define HC(o_, expr) HANDLER(LC_, o_, expr)
+#define PAIR(v, x, ex, y, ey)                           \
+  LP##v##_##x##_##y:                                    \
+    w[ip->d] = (ex);                                    \
+    r = (ey);                                           \
+    w[ip[1].d] = r;                                     \
+    ip += 2;                                            \
+    a = w[ip->a];                                       \
+    goto *ip->op;
+#define A2 (w[ip[1].a])
+#define B2 (w[ip[1].b])
+#define C2 (w[ip[1].c])
 #define A a
 #define B (w[ip->b])
 #define C (w[ip->c])
   DM_TAPE_OPS(H0)
+  DM_TAPE_PAIRS(PAIR, V0)
 #undef A
 #define A r
   DM_TAPE_OPS(HA)
+  DM_TAPE_PAIRS(PAIR, VA)
 #undef A
 #undef B
 #define A a
 #define B r
   DM_TAPE_BINARY(HB)
   DM_TAPE_TERNARY(HB)
+  DM_TAPE_PAIRS(PAIR, VB)
 #undef B
 #undef C
 #define B (w[ip->b])
 #define C r
   DM_TAPE_TERNARY(HC)
+  DM_TAPE_PAIRS(PAIR, VC)
 #undef A
 #undef B
 #undef C
+#undef A2
+#undef B2
+#undef C2
+#undef PAIR
 #undef H0
 #undef HA
 #undef HB
@@ -194,6 +241,8 @@ L_halt:
     for (int i = 0; i < NVAR * DM_T_NOPS; i++)
       labels[i] = (const void *)(uintptr_t)(i % DM_T_NOPS);
     labels[NVAR * DM_T_NOPS] = (const void *)(uintptr_t)DM_T_NOPS;
+    for (int i = PAIR_BASE; i < NLABELS; i++)
+      labels[i] = NULL;                 /* no pairs */
     return;
   }
   for (const dm_tape_xins *ip = t->xcode; ; ip++) {
@@ -236,9 +285,20 @@ static int variant(const dm_tape_ins *c, int64_t prev)
   return V0;
 }
 
+/* 1 if instruction c reads register reg. */
+static int reads(const dm_tape_ins *c, uint32_t reg)
+{
+  int op = (int)(c->code & 0xff);
+  int binary = (op >= DM_T_ADD && op <= DM_T_DIV) || op == DM_T_POW ||
+               op == DM_T_ATAN2 || (op >= DM_T_LT && op <= DM_T_NE);
+  int ternary = op == DM_T_SELECT || (op >= DM_T_MULADD && op <= DM_T_MUL3);
+  return c->a == reg || ((binary || ternary) && c->b == reg) ||
+         (ternary && (c->code >> 8) == reg);
+}
+
 int dm_tape__thread(dm_tape *t)
 {
-  const void *labels[NVAR * DM_T_NOPS + 1];
+  const void *labels[NLABELS];
   run(NULL, NULL, labels);
   t->xcode = malloc((t->ninstr + 1) * sizeof *t->xcode);
   if (t->xcode == NULL)
@@ -252,6 +312,17 @@ int dm_tape__thread(dm_tape *t)
       h = labels[op];
     t->xcode[i] = (dm_tape_xins){ h, c->d, c->a, c->b, c->code >> 8 };
     prev = c->d;
+    if (i + 1 < t->ninstr) {          /* and the next one, as a pair? */
+      const dm_tape_ins *n = &t->code[i + 1];
+      int px = pair_index[op], py = pair_index[n->code & 0xff];
+      h = px && py ? labels[PAIR_AT(v, px - 1, py - 1)] : NULL;
+      if (h != NULL && !reads(n, c->d) && n->d != c->d) {
+        t->xcode[i].op = h;
+        t->xcode[i + 1] = (dm_tape_xins){ NULL, n->d, n->a, n->b, n->code >> 8 };
+        prev = n->d;
+        i++;
+      }
+    }
   }
   t->xcode[t->ninstr] = (dm_tape_xins){ labels[NVAR * DM_T_NOPS], 0, 0, 0, 0 };
   return DM_OK;
@@ -263,6 +334,9 @@ void dm_tape_run(const dm_tape *t, const double *in, const double *par,
   load(t, in, par, w);
   if (t->ninstr > 0)
     run(t, w, NULL);
+  const uint32_t (*c)[2] = (const uint32_t (*)[2])t->copy;
+  for (size_t j = 0; j < t->ncopy; j++)
+    w[c[j][0]] = w[c[j][1]];
 }
 
 #undef B

@@ -17,6 +17,12 @@ typedef struct dm_tape_xins {
 
 struct dm_tape {
   size_t nin, npar, nconst, nout, ninstr, nregs;
+  size_t nslot, slot0;      /* output slots: registers slot0 .. +nslot */
+  size_t ncopy;             /* at the end of a run, register copy[j][1] */
+  uint32_t (*copy)[2];      /* into register copy[j][0] (slots) */
+  double *preset;           /* the constants and the slots: what the
+                               registers from nin + npar hold before a run
+                               (constant outputs are there already) */
   dm_tape_ins *code;
   dm_tape_xins *xcode;      /* ninstr + 1: the last one stops */
   double *consts;

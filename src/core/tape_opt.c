@@ -75,6 +75,16 @@ typedef struct opt {
   int32_t *freq;        /* per atom: monomials with it */
   struct { int32_t node; int64_t e; } *stk;
   size_t capstk;
+  /* the sums emitted so far by their terms (canonical factor order):
+   * sums[j] is the value of terms rterm[sums[j].off .. +n) */
+  struct sument { uint64_t h; size_t off, n; dm_expr node; int neg; } *sums;
+  size_t nsums, capsums;
+  int32_t *stab;        /* hash table of indices into sums, -1 empty */
+  size_t stabcap;
+  struct rterm { double c; size_t foff, n; } *rterm;
+  size_t nrterm, caprterm;
+  fac *rfac;
+  size_t nrfac, caprfac;
   dm_expr one;
   int nomem;
 } opt;
@@ -373,6 +383,103 @@ static int cmp_occ(const void *p, const void *q)
   return (x->sgn > y->sgn) - (x->sgn < y->sgn);
 }
 
+/* {==================================================================
+ * sums already emitted, found again by their terms
+ * =================================================================== */
+
+static uint64_t mix(uint64_t h)
+{
+  return dm_expr__mix64(h);
+}
+
+/* Hash of a term (factors in any order). */
+static uint64_t term_hash(const mterm *t)
+{
+  uint64_t s = 0;
+  for (size_t i = 0; i < t->n; i++)
+    s += mix((uint64_t)(uint32_t)t->f[i].atom * 0x9e3779b97f4a7c15ULL ^
+             (uint64_t)(uint32_t)t->f[i].e);
+  return mix(s ^ mix(dm_expr__dbits(t->c)) ^ t->n);
+}
+
+static int same_term(const opt *o, const struct rterm *x, const mterm *y)
+{
+  if (x->n != y->n || dm_expr__dbits(x->c) != dm_expr__dbits(y->c))
+    return 0;
+  const fac *f = o->rfac + x->foff;
+  for (size_t i = 0; i < x->n; i++)   /* both in canonical factor order */
+    if (f[i].atom != y->f[i].atom || f[i].e != y->f[i].e)
+      return 0;
+  return 1;
+}
+
+/* The registered sum with hash h whose terms are T[0..nt) but T[skip]. */
+static const struct sument *sum_find(const opt *o, uint64_t h, const mterm *T,
+                                     size_t nt, size_t skip)
+{
+  size_t n = nt - (skip < nt);
+  if (o->stabcap == 0 || n < 2)
+    return NULL;
+  size_t mask = o->stabcap - 1;
+  for (size_t j = h & mask; o->stab[j] >= 0; j = (j + 1) & mask) {
+    const struct sument *e = &o->sums[o->stab[j]];
+    if (e->h != h || e->n != n || e->node < 0)
+      continue;
+    size_t hit = 0;
+    for (size_t a = 0; a < n; a++)       /* small sums: every pair */
+      for (size_t b = 0; b < nt; b++)
+        if (b != skip && same_term(o, &o->rterm[e->off + a], &T[b])) {
+          hit++;
+          break;
+        }
+    if (hit == n)
+      return e;
+  }
+  return NULL;
+}
+
+/* Remember T[0..nt) (hash h) as the sum with value val (DM_EXPR_NONE:
+ * set later through the index returned; -1 when not remembered). */
+static long sum_put(opt *o, uint64_t h, const mterm *T, size_t nt, sv val)
+{
+  size_t nf = 0;
+  for (size_t i = 0; i < nt; i++)
+    nf += T[i].n;
+  if (grow(&o->sums, &o->capsums, o->nsums + 1, sizeof *o->sums) ||
+      grow(&o->rterm, &o->caprterm, o->nrterm + nt, sizeof *o->rterm) ||
+      grow(&o->rfac, &o->caprfac, o->nrfac + nf, sizeof *o->rfac))
+    return -1;                         /* (only a missed reuse) */
+  if (2 * (o->nsums + 1) > o->stabcap) {
+    size_t cap = o->stabcap ? 2 * o->stabcap : 256;
+    int32_t *t = malloc(cap * sizeof *t);
+    if (t == NULL)
+      return -1;
+    for (size_t j = 0; j < cap; j++)
+      t[j] = -1;
+    for (size_t k = 0; k < o->nsums; k++) {
+      size_t j = o->sums[k].h & (cap - 1);
+      while (t[j] >= 0)
+        j = (j + 1) & (cap - 1);
+      t[j] = (int32_t)k;
+    }
+    free(o->stab);
+    o->stab = t;
+    o->stabcap = cap;
+  }
+  struct sument *e = &o->sums[o->nsums];
+  *e = (struct sument){ h, o->nrterm, nt, val.n, val.neg };
+  for (size_t i = 0; i < nt; i++) {
+    o->rterm[o->nrterm++] = (struct rterm){ T[i].c, o->nrfac, T[i].n };
+    memcpy(o->rfac + o->nrfac, T[i].f, T[i].n * sizeof *T[i].f);
+    o->nrfac += T[i].n;
+  }
+  size_t j = h & (o->stabcap - 1);
+  while (o->stab[j] >= 0)
+    j = (j + 1) & (o->stabcap - 1);
+  o->stab[j] = (int32_t)o->nsums;
+  return (long)o->nsums++;
+}
+
 /* Terms in a canonical order (by their sorted factors, then |c|), so that
  * equal sums give equal nodes and -S gives the negation of S exactly. */
 static int cmp_term(const void *p, const void *q)
@@ -397,8 +504,11 @@ static void canon_terms(opt *o, mterm *T, size_t nt)
   qsort(T, nt, sizeof *T, cmp_term);
 }
 
-/* The sum of T[0..nt), greedily factored; T's factor arrays may be
- * reordered. */
+static sv factor_new(opt *o, mterm *T, size_t nt);
+
+/* The sum of T[0..nt), greedily factored, or found among the sums emitted
+ * before (also when it is one of them plus a term); T's factor arrays
+ * may be reordered. */
 static sv factor(opt *o, mterm *T, size_t nt)
 {
   sv bad = { DM_EXPR_NONE, 0 };
@@ -408,6 +518,42 @@ static sv factor(opt *o, mterm *T, size_t nt)
     return (sv){ konst(o, 0.0), 0 };
   if (nt == 1)
     return monomial(o, T[0].f, T[0].n, T[0].c);
+  /* this sum, or it but one term, emitted before? */
+  sort_opt = o;
+  uint64_t H = 0, *ht = malloc(nt * sizeof *ht);
+  if (ht == NULL) {
+    o->nomem = 1;
+    return bad;
+  }
+  for (size_t i = 0; i < nt; i++) {
+    qsort(T[i].f, T[i].n, sizeof *T[i].f, cmp_fac);
+    H += ht[i] = term_hash(&T[i]);
+  }
+  const struct sument *e = sum_find(o, H, T, nt, nt);
+  for (size_t i = 0; e == NULL && i < nt; i++)
+    if ((e = sum_find(o, H - ht[i], T, nt, i)) != NULL) {
+      sv r = sv_add(o, (sv){ e->node, e->neg },
+                    monomial(o, T[i].f, T[i].n, T[i].c));
+      sum_put(o, H, T, nt, r);
+      free(ht);
+      return r;
+    }
+  free(ht);
+  if (e != NULL)
+    return (sv){ e->node, e->neg };
+  long k = sum_put(o, H, T, nt, bad);  /* before factor_new changes T */
+  sv res = factor_new(o, T, nt);
+  if (k >= 0) {
+    o->sums[k].node = res.n;
+    o->sums[k].neg = res.neg;
+  }
+  return res;
+}
+
+/* factor() of a sum not seen before. */
+static sv factor_new(opt *o, mterm *T, size_t nt)
+{
+  sv bad = { DM_EXPR_NONE, 0 };
   size_t nocc = 0;
   for (size_t i = 0; i < nt; i++)
     nocc += T[i].n;
@@ -570,6 +716,10 @@ static void opt_free(opt *o)
   free(o->dcount);
   free(o->freq);
   free(o->stk);
+  free(o->sums);
+  free(o->stab);
+  free(o->rterm);
+  free(o->rfac);
 }
 
 int dm_tape__optimize(dm_expr_ctx *ctx, size_t nout, const dm_expr *out,
