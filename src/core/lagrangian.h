@@ -6,8 +6,11 @@
  * (symmetric blocks derived on the upper triangle only), force Jacobians
  * Fq, Fv, the constraint Jacobian G and second derivatives H; compiles them
  * to tapes -- one for DM_LAG_GRAD requests (L, Lq, Lv), one for everything,
- * so gradient-only evaluations stay cheap -- optionally to native code
- * (native.h), and fills a dm_system whose callbacks run them.
+ * so gradient-only evaluations stay cheap; both from one rewriting of the
+ * outputs (dm_tape_optimize), so that they agree bit for bit -- optionally
+ * to native code (native.h), and fills a dm_system whose callbacks run
+ * them.  On the tape path the outputs are laid out in the tape's slots as
+ * in the caller's arrays, which are then copied whole.
  *
  * Structure detected symbolically:
  *  - DM_SYS_MECHANICAL when no entry of Lvv contains a velocity (L is
@@ -19,8 +22,11 @@
  *    re-evaluate the mass (it clears the flag when M stops being positive
  *    definite and sets it again when it is).
  *
- * Callbacks return 0, or 1 (recoverable, system.h) when a requested output
- * is NaN or infinite -- e.g. sqrt of a negative number outside the domain.
+ * Callbacks return 0, or 1 (recoverable, system.h) when an output of the
+ * program that runs (the gradient one for DM_LAG_GRAD requests, else the
+ * full one; requested or not) is NaN or infinite -- e.g. sqrt of a
+ * negative number outside the domain; the requested arrays are then
+ * unspecified.
  *
  * Requires dm_gsl_init() (GSL's abort handler off): the positive
  * definiteness test may make GSL report an error.
