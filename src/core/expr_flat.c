@@ -70,16 +70,18 @@ int dm_expr__grow(void *pp, size_t *cap, size_t need, size_t size)
 
 dm_nel *dm_expr__new_el(dm_expr_ctx *ctx, dm_flat *f)
 {
-  if (grow(&ctx->nel[f->w], &ctx->nelcap[f->w], f->n + 1, sizeof(dm_nel)))
+  if (f->n >= ctx->nelcap[f->w] &&
+      grow(&ctx->nel[f->w], &ctx->nelcap[f->w], f->n + 1, sizeof(dm_nel)))
     return NULL;
   dm_nel *x = &ctx->nel[f->w][f->n++];
   memset(x, 0, sizeof *x);
   return x;
 }
 
-static int walk_push(dm_expr_ctx *ctx, size_t *ns, dm_expr e, int64_t ex)
+static inline int walk_push(dm_expr_ctx *ctx, size_t *ns, dm_expr e, int64_t ex)
 {
-  if (grow(&ctx->walk, &ctx->walkcap, *ns + 1, sizeof(dm_nwalk)))
+  if (*ns >= ctx->walkcap &&
+      grow(&ctx->walk, &ctx->walkcap, *ns + 1, sizeof(dm_nwalk)))
     return -1;
   ctx->walk[*ns].node = e;
   ctx->walk[*ns].e = ex;
@@ -312,6 +314,19 @@ static int same(dm_expr_ctx *ctx, dm_expr e, int prod, const dm_nel *E,
     B[i] = E[i];
     if (prod)
       A[i].c = B[i].c = 0;
+  }
+  if (n <= 12) {                       /* small: match pairs, no sort */
+    for (size_t i = 0; i < n; i++) {
+      size_t j = i;
+      while (j < n && cmp_el(&A[i], &B[j]) != 0)
+        j++;
+      if (j == n)
+        return 0;
+      dm_nel t = B[i];                 /* used ones move to the front */
+      B[i] = B[j];
+      B[j] = t;
+    }
+    return 1;
   }
   qsort(A, n, sizeof *A, cmp_el);
   qsort(B, n, sizeof *B, cmp_el);
