@@ -355,8 +355,7 @@ static double sign_of(double x)
 }
 
 /* The value of a unary op at a constant. */
-double dm_expr__unary_value(int op, double x);
-double dm_expr__unary_value(int op, double x)
+double dm_expr_unary_value(int op, double x)
 {
   switch (op) {
   case DM_EXPR_NEG: return -x;
@@ -379,8 +378,7 @@ double dm_expr__unary_value(int op, double x)
 }
 
 /* The value of a binary op (not POWI) at constants. */
-double dm_expr__binary_value(int op, double a, double b);
-double dm_expr__binary_value(int op, double a, double b)
+double dm_expr_binary_value(int op, double a, double b)
 {
   switch (op) {
   case DM_EXPR_ADD: return a + b;
@@ -410,7 +408,7 @@ dm_expr dm_expr_unary(dm_expr_ctx *ctx, int op, dm_expr a)
     return dm_expr_neg(ctx, a);
   double c;
   if (isc(ctx, a, &c))
-    return K(dm_expr__unary_value(op, c));
+    return K(dm_expr_unary_value(op, c));
   const dm_node *nd = &ctx->node[a];
   switch (op) {
   case DM_EXPR_ABS:
@@ -437,7 +435,7 @@ static dm_expr compare(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
 {
   double ca, cb;
   if (isc(ctx, a, &ca) && isc(ctx, b, &cb))
-    return K(dm_expr__binary_value(op, ca, cb));
+    return K(dm_expr_binary_value(op, ca, cb));
   if (op == DM_EXPR_EQ || op == DM_EXPR_NE)
     return cons_comm(ctx, op, a, b);
   return cons(ctx, op, a, b, -1);

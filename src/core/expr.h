@@ -95,6 +95,11 @@ dm_expr dm_expr_neg(dm_expr_ctx *ctx, dm_expr a);
 dm_expr dm_expr_unary(dm_expr_ctx *ctx, int op, dm_expr a);
 dm_expr dm_expr_binary(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b);
 dm_expr dm_expr_select(dm_expr_ctx *ctx, dm_expr cond, dm_expr a, dm_expr b);
+/* The value of a unary op (NEG .. SIGN) or binary op (ADD .. NE, not POWI)
+ * at numbers: what constant folding computes; comparisons give 1 or 0;
+ * an op of the other kind gives NaN. */
+double dm_expr_unary_value(int op, double x);
+double dm_expr_binary_value(int op, double a, double b);
 /* Apply a function by name ("sin", "atan2", "pow", "select", "lt", ...);
  * unknown name or wrong number of arguments records DM_ENOTFOUND or
  * DM_EINVAL with a message naming the function. */

@@ -10,8 +10,6 @@
 #include <string.h>
 
 double dm_expr__powi_value(double x, int n);
-double dm_expr__unary_value(int op, double x);
-double dm_expr__binary_value(int op, double a, double b);
 
 /* {==================================================================
  * reachable sets
@@ -507,9 +505,9 @@ int dm_expr_eval(dm_expr_ctx *ctx, size_t ne, const dm_expr *e, double *out,
       if (nd.op == DM_EXPR_POWI)
         v = dm_expr__powi_value(a, nd.b);
       else if (k == 1)
-        v = dm_expr__unary_value(nd.op, a);
+        v = dm_expr_unary_value(nd.op, a);
       else if (k == 2)
-        v = dm_expr__binary_value(nd.op, a, b);
+        v = dm_expr_binary_value(nd.op, a, b);
       else
         v = a != 0 ? b : val[ctx->aux[nd.c]];
     }

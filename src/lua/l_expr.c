@@ -179,38 +179,13 @@ static int m_concat(lua_State *L)
  * functions: numbers in, numbers out; expressions in, expressions out
  * ======================================================================= */
 
-static double sign_of(double x)
-{
-  return x > 0 ? 1.0 : x < 0 ? -1.0 : x == 0 ? 0.0 : x;
-}
-
-static double num_unary(int op, double x)
-{
-  switch (op) {
-  case DM_EXPR_SQRT: return sqrt(x);
-  case DM_EXPR_EXP: return exp(x);
-  case DM_EXPR_LOG: return log(x);
-  case DM_EXPR_SIN: return sin(x);
-  case DM_EXPR_COS: return cos(x);
-  case DM_EXPR_TAN: return tan(x);
-  case DM_EXPR_ASIN: return asin(x);
-  case DM_EXPR_ACOS: return acos(x);
-  case DM_EXPR_ATAN: return atan(x);
-  case DM_EXPR_SINH: return sinh(x);
-  case DM_EXPR_COSH: return cosh(x);
-  case DM_EXPR_TANH: return tanh(x);
-  case DM_EXPR_ABS: return fabs(x);
-  default: return sign_of(x);
-  }
-}
-
 static int unary(lua_State *L, int op)
 {
   const char *name = dm_expr_op_name(op);
   if (lua_gettop(L) != 1)
     return luaL_error(L, "dm.%s expects 1 argument, got %d", name, lua_gettop(L));
   if (lua_type(L, 1) == LUA_TNUMBER) {
-    lua_pushnumber(L, num_unary(op, lua_tonumber(L, 1)));
+    lua_pushnumber(L, dm_expr_unary_value(op, lua_tonumber(L, 1)));
     return 1;
   }
   dm_expr a = dm_lua_checkexpr(L, 1);
@@ -239,17 +214,11 @@ static int binary(lua_State *L, int op)
   if (lua_gettop(L) != 2)
     return luaL_error(L, "dm.%s expects 2 arguments, got %d", name, lua_gettop(L));
   if (numeric_args(L, 2)) {
-    double a = lua_tonumber(L, 1), b = lua_tonumber(L, 2);
-    switch (op) {
-    case DM_EXPR_ATAN2: lua_pushnumber(L, atan2(a, b)); break;
-    case DM_EXPR_POW: lua_pushnumber(L, pow(a, b)); break;
-    case DM_EXPR_LT: lua_pushboolean(L, a < b); break;
-    case DM_EXPR_LE: lua_pushboolean(L, a <= b); break;
-    case DM_EXPR_GT: lua_pushboolean(L, a > b); break;
-    case DM_EXPR_GE: lua_pushboolean(L, a >= b); break;
-    case DM_EXPR_EQ: lua_pushboolean(L, a == b); break;
-    default: lua_pushboolean(L, a != b); break;
-    }
+    double r = dm_expr_binary_value(op, lua_tonumber(L, 1), lua_tonumber(L, 2));
+    if (op >= DM_EXPR_LT && op <= DM_EXPR_NE)
+      lua_pushboolean(L, r != 0.0);   /* comparisons of numbers are booleans */
+    else
+      lua_pushnumber(L, r);
     return 1;
   }
   dm_expr a = dm_lua_checkexpr(L, 1), b = dm_lua_checkexpr(L, 2);
