@@ -7,6 +7,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <gsl/gsl_errno.h>
@@ -26,6 +27,13 @@ typedef struct prog {
   size_t slot0;
   uint32_t narr, aoff[33];
   uint32_t nchk, *chk;            /* the registers to test for NaN/Inf */
+  size_t nin;                     /* inputs: 2n (q, v), or n (q only) */
+  unsigned have;                  /* bits of the arrays it fills */
+  unsigned fill;                  /* Lagrangian bundles: mask bits always
+                                     passed (L, whose storage is always
+                                     there, and the arrays it lacks), so
+                                     that a request of all it has takes
+                                     the direct path */
 } prog;
 
 typedef struct lag_data {
@@ -34,6 +42,8 @@ typedef struct lag_data {
   char **coords, **params;
   double *par, *mass;
   prog grad, all;             /* L, Lq, Lv | + Lvv, Lvq, Lqq */
+  prog lq, qvqq;              /* separable L: Lq (of q alone) | Lq, Lv, Lqq */
+  const prog *sel[DM_LAG_ALL + 1];  /* the cheapest bundle for each request */
   prog force, force_all;      /* F | + Fq, Fv */
   prog constr, constr_all;    /* g, G | + H */
   prog massp;                 /* Lvv (n*n) when constant in q and v */
@@ -61,8 +71,8 @@ static void lag_free_data(lag_data *d)
   free(d->name);
   free(d->par);
   free(d->mass);
-  prog *ps[] = { &d->grad, &d->all, &d->force, &d->force_all, &d->constr,
-                 &d->constr_all, &d->massp };
+  prog *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force, &d->force_all,
+                 &d->constr, &d->constr_all, &d->massp };
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
     prog_free(ps[i]);
   free(d);
@@ -143,16 +153,17 @@ static int lag_eval(void *data, const double *q, const double *v,
 {
   const lag_data *d = data;
   const size_t n = d->n;
-  const prog *p = (what & ~(unsigned)DM_LAG_GRAD) ? &d->all : &d->grad;
+  const prog *p = d->sel[what & DM_LAG_ALL];
   double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    return p->scatter(in, par, o, what | DM_LAG_L);
+    return p->scatter(in, par, o, what | DM_LAG_L | p->fill);
   }
   double *w = work;
   copy(w, q, n);
-  copy(w + n, v, n);
-  return tape_scatter(p, w, par, o, what | DM_LAG_L);
+  if (p->nin > n)
+    copy(w + n, v, n);
+  return tape_scatter(p, w, par, o, what | DM_LAG_L | p->fill);
 }
 
 static int force_eval(void *data, const double *q, const double *v,
@@ -281,8 +292,13 @@ static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
       size[a] = outmap[j].elem + 1;
   }
   p->aoff[0] = 0;
-  for (uint32_t a = 0; a < p->narr; a++)
+  p->have = 0;
+  for (uint32_t a = 0; a < p->narr; a++) {
     p->aoff[a + 1] = p->aoff[a] + size[a];
+    p->have |= size[a] ? 1u << a : 0u;
+  }
+  p->fill = (p->narr >= 32 ? ~0u : (1u << p->narr) - 1) & ~p->have;
+  p->nin = nin;
   int s = p->aoff[p->narr] == nmap ? DM_OK
           : dm_err_set(b->err, DM_EFAILED, "internal: output blocks leave gaps");
   for (size_t j = 0; j < nmap; j++)
@@ -468,6 +484,29 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
   return DM_OK;
 }
 
+/* For every request mask, the bundle that covers it at the least cost
+ * (tape instructions, plus the outputs copied when it has more arrays
+ * than asked for). */
+static void select_progs(lag_data *d)
+{
+  const prog *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
+  for (unsigned w = 0; w <= DM_LAG_ALL; w++) {
+    const prog *best = &d->all;
+    size_t bc = SIZE_MAX;
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
+      const prog *p = ps[i];
+      if (p->tape == NULL || (w & ~p->have) != 0)
+        continue;
+      size_t c = dm_tape_ninstr(p->tape) + ((p->have & ~(w | DM_LAG_L)) ? p->nout : 0);
+      if (c < bc) {
+        bc = c;
+        best = p;
+      }
+    }
+    d->sel[w] = best;
+  }
+}
+
 /* L and its derivatives: tapes grad and all, and the structure flags. */
 static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
 {
@@ -519,12 +558,28 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
   }
   if ((s = dm_tape_optimize(b->ctx, nall, out, ow, b->err)) != DM_OK ||
       (s = compile_prog(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = compile_prog(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK) {
+      (s = compile_prog(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK) {
     free(ow);
     goto done;
   }
+  if (d->mass_possible) {
+    /* separable (Lvq = 0, Lvv constant): Lq depends on q alone, and the
+     * integrators ask for Lq alone (Stormer-Verlet) or for Lq, Lv, Lqq
+     * (the Newton matrix, Lvv being the mass); both bundles from the same
+     * rewritten outputs, so their values are those of grad and all */
+    const block bq[] = { { 1, BLK_VEC, n, 1, 0 } };
+    const block bqv[] = { { 1, BLK_VEC, n, 1, 0 }, { 2, BLK_VEC, n, 1, 0 },
+                          { 5, BLK_SYM, n, 1, 0 } };
+    memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
+    if ((s = compile_prog(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
+        (s = compile_prog(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK) {
+      free(ow);
+      goto done;
+    }
+  }
   free(ow);
-  s = detect_structure(b, d, Lv, Lvv, Lvq, flags);
+  select_progs(d);
 done:
   free(out);
   free(Lvv);
@@ -671,8 +726,8 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
     goto fail;
 
   size_t need = 0;
-  const prog *ps[] = { &d->grad, &d->all, &d->force, &d->force_all,
-                       &d->constr, &d->constr_all };
+  const prog *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force,
+                       &d->force_all, &d->constr, &d->constr_all };
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
     if (prog_need(ps[i]) > need)
       need = prog_need(ps[i]);
@@ -732,5 +787,9 @@ int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st)
   st->native_all = d->all.fn != NULL;
   st->ninstr_force = d->force_all.tape ? dm_tape_ninstr(d->force_all.tape) : 0;
   st->ninstr_constr = d->constr_all.tape ? dm_tape_ninstr(d->constr_all.tape) : 0;
+  st->ninstr_q = d->lq.tape ? dm_tape_ninstr(d->lq.tape) : 0;
+  st->ninstr_sep = d->qvqq.tape ? dm_tape_ninstr(d->qvqq.tape) : 0;
+  st->native_q = d->lq.fn != NULL;
+  st->native_sep = d->qvqq.fn != NULL;
   return DM_OK;
 }

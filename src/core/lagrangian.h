@@ -6,7 +6,10 @@
  * (symmetric blocks derived on the upper triangle only), force Jacobians
  * Fq, Fv, the constraint Jacobian G and second derivatives H; compiles them
  * to tapes -- one for DM_LAG_GRAD requests (L, Lq, Lv), one for everything,
- * so gradient-only evaluations stay cheap; both from one rewriting of the
+ * so gradient-only evaluations stay cheap, and for a separable L (below)
+ * one for Lq alone (a function of q: the force of Stormer-Verlet) and one
+ * for Lq, Lv, Lqq (the Newton matrix when Lvv is the mass); each request
+ * runs the cheapest bundle that covers it; all from one rewriting of the
  * outputs (dm_tape_optimize), so that they agree bit for bit -- optionally
  * to native code (native.h), and fills a dm_system whose callbacks run
  * them.  On the tape path the outputs are laid out in the tape's slots as
@@ -77,6 +80,10 @@ typedef struct dm_lagrangian_stats {
   size_t nregs_all;
   int native_grad, native_all;        /* 1 when native code runs */
   size_t ninstr_force, ninstr_constr; /* 0 when absent */
+  /* separable L (Lvv constant, Lvq = 0): the bundles Lq (of q alone) and
+   * Lq, Lv, Lqq; 0 when not built */
+  size_t ninstr_q, ninstr_sep;
+  int native_q, native_sep;
 } dm_lagrangian_stats;
 
 int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st);

@@ -124,6 +124,84 @@ static void test_j2(void)
   tap_ok(s.data == NULL && s.lagrangian == NULL, "release zeroes the system");
 }
 
+static int make_dsp(dm_system *s, int native, dm_expr *vars, dm_expr *par,
+                    dm_err *err);
+
+/* Separable L: the bundles Lq (of q alone) and Lq, Lv, Lqq give what the
+ * gradient and full bundles give, bit for bit, on the tape and in native
+ * code; the Lq bundle does not read v. */
+static void test_bundles(void)
+{
+  static const char *const qn[3] = { "x", "y", "z" }, *const vn[3] = { "vx", "vy", "vz" };
+  dm_expr q[3], v[3], par;
+  syms(qn, 3, q);
+  syms(vn, 3, v);
+  par = dm_expr_param(C, "pJ2");
+  double J2 = 0.05, x[3] = { 1.2385, -0.4172, 0.6031 }, vv[3] = { 0.21, 0.83, -0.17 };
+  double vnan[3] = { NAN, NAN, NAN };
+  full ref[4];                  /* tape: Q, Q|V|QQ, GRAD, ALL */
+  const unsigned ws[4] = { DM_LAG_Q, DM_LAG_Q | DM_LAG_V | DM_LAG_QQ, DM_LAG_GRAD, DM_LAG_ALL };
+  for (int nat = 0; nat < 2; nat++) {
+    dm_lagrangian_spec sp = { .name = "J2", .n = 3, .q = q, .v = v, .npar = 1,
+      .par = &par, .par_values = &J2, .L = tx_parse(C, tx_j2_lagrangian),
+      .native = nat ? DM_NATIVE_AUTO : DM_NATIVE_NEVER, .q0 = x, .v0 = vv };
+    dm_system s;
+    dm_lagrangian_stats ls;
+    int st = dm_lagrangian_compile(C, &sp, &s, NULL);
+    dm_lagrangian_stats_get(&s, &ls);
+    if (nat && !(ls.native_q && ls.native_sep)) {
+      tap_ok(st == DM_OK, "# SKIP no C compiler");
+      tap_ok(st == DM_OK, "# SKIP no C compiler");
+      dm_system_release(&s);
+      break;
+    }
+    const char *how = nat ? "native" : "tape";
+    if (!nat) {
+      tap_diag("J2 bundles: Lq %zu, Lq+Lv+Lqq %zu, L+grad %zu, all %zu instructions",
+               ls.ninstr_q, ls.ninstr_sep, ls.ninstr_grad, ls.ninstr_all);
+      tap_ok(st == DM_OK && ls.ninstr_q > 0 && ls.ninstr_q < ls.ninstr_grad &&
+             ls.ninstr_sep > 0 && ls.ninstr_sep < ls.ninstr_all,
+             "separable J2: the Lq and Lq+Lv+Lqq bundles are smaller than grad and all");
+    }
+    full f[4];
+    int rc = 0, same = 1;
+    for (int k = 0; k < 4; k++) {
+      memset(&f[k], 0, sizeof f[k]);
+      rc |= call(&s, x, vv, ws[k], &f[k]);
+    }
+    for (int k = 0; k < 4; k++) {
+      same &= memcmp(f[k].Lq, f[3].Lq, 3 * sizeof(double)) == 0;
+      if (ws[k] & DM_LAG_V)
+        same &= memcmp(f[k].Lv, f[3].Lv, 3 * sizeof(double)) == 0;
+      if (ws[k] & DM_LAG_QQ)
+        same &= memcmp(f[k].Lqq, f[3].Lqq, 9 * sizeof(double)) == 0;
+      if (nat)                  /* native = tape, request by request */
+        same &= memcmp(f[k].Lq, ref[k].Lq, 3 * sizeof(double)) == 0 &&
+                memcmp(f[k].Lqq, ref[k].Lqq, 9 * sizeof(double)) == 0 &&
+                memcmp(f[k].Lv, ref[k].Lv, 3 * sizeof(double)) == 0;
+      else
+        ref[k] = f[k];
+    }
+    tap_ok(rc == 0 && same, "%s: Lq, Lv, Lqq the same bit for bit from every bundle%s", how,
+           nat ? " and as on the tape" : "");
+    /* Lq alone ignores v (NaN velocities); the gradient bundle sees them */
+    full g;
+    int r1 = call(&s, x, vnan, DM_LAG_Q, &g), r2 = call(&s, x, vnan, DM_LAG_GRAD, &f[0]);
+    tap_ok(r1 == 0 && r2 == 1 && memcmp(g.Lq, f[3].Lq, 3 * sizeof(double)) == 0,
+           "%s: an Lq request runs the bundle of q alone (v = NaN: %d), "
+           "a gradient request sees v (%d)", how, r1, r2);
+    dm_system_release(&s);
+  }
+  /* not separable: no extra bundles */
+  dm_expr vars[8], dpar[5];
+  dm_system d;
+  dm_lagrangian_stats ls;
+  make_dsp(&d, DM_NATIVE_NEVER, vars, dpar, NULL);
+  dm_lagrangian_stats_get(&d, &ls);
+  tap_ok(ls.ninstr_q == 0 && ls.ninstr_sep == 0, "double spherical pendulum: no separable bundles");
+  dm_system_release(&d);
+}
+
 /* {==================================================================
  * double spherical pendulum against the complex step
  * =================================================================== */
@@ -426,6 +504,7 @@ int main(void)
   C = dm_expr_ctx_alloc();
   test_j2();
   test_dsp();
+  test_bundles();
   test_flags();
   test_force_constraints();
   test_errors();
