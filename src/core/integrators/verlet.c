@@ -214,76 +214,129 @@ int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
   return DM_OK;
 }
 
+/* The drift of one component: u = M^{-1} ph (unit or diagonal mass),
+ * q1 = q + h u with Kahan compensation (carry c in, *cn out). */
+static inline double drift1(int kind, double mii, double h, double ph, double q, double c,
+                            double *cn, double *u)
+{
+  double uu = kind == DM_MASS_UNIT ? ph : mii * ph, y = h * uu - c, t = q + y;
+  *cn = (t - q) - y;
+  *u = uu;
+  return t;
+}
+
+/* The drift of a whole step into q1, cn, u from (q, p + h/2 f, carries c). */
+static void drift(const dm_prk *P, double h, const double *q, const double *p, const double *f,
+                  const double *c, double *q1, double *cn, double *u, double *ph)
+{
+  size_t n = P->n, i;
+  const double hh = 0.5 * h;
+  if (P->mass_kind == DM_MASS_FULL) {
+    for (i = 0; i < n; i++)
+      ph[i] = p[i] + hh * f[i];
+    minv_mul(P, ph, u);
+    for (i = 0; i < n; i++) {
+      double y = h * u[i] - c[i], t = q[i] + y;
+      cn[i] = (t - q[i]) - y;
+      q1[i] = t;
+    }
+    return;
+  }
+  for (i = 0; i < n; i++)
+    q1[i] = drift1(P->mass_kind, P->Minv[i * n + i], h, p[i] + hh * f[i], q[i], c[i], cn + i,
+                   u + i);
+}
+
 /* The run loop's fast path for unconstrained Stormer-Verlet: nsteps steps
  * in place, one force evaluation per step (first same as last), Kahan
- * compensated updates, no copies beyond the state itself.  Same arithmetic
+ * compensated updates.  The kick of step k and the drift of step k + 1
+ * run in one pass (the drift's position goes to a buffer and becomes the
+ * state when step k + 1 succeeds), so the new momenta flow to the next
+ * positions in registers: the dependency chain of a step holds the force
+ * and a few additions, not loads of values just stored.  Same arithmetic
  * as dm_prk_verlet_step, so results are bitwise identical to stepping. */
 int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p, long *done,
                           dm_integ_stats *stt, dm_err *e)
 {
   const dm_system *sys = P->sys;
-  size_t n = P->n, i;
-  double *f0 = P->Lq, *f1 = P->Lq + n, *u = P->X, *q1 = P->q1w, *ph = P->dp, *tmp;
-  double *cq = P->cq, *cp = P->cp;
-  const double hh = 0.5 * h;
+  const size_t n = P->n;
+  const int kind = P->mass_kind;
+  const double hh = 0.5 * h, *Mi = P->Minv;
+  double *f0 = P->Lq, *f1 = P->Lq + n, *tmp;
+  /* speculative positions of the next step, and the position carries and
+   * drift velocities of the state (c), of the next step (s) and of the one
+   * after (t), rotated as steps complete */
+  double *qs = P->q1w, *qt = P->tmp, *pn = P->dp, *ph = P->Q + n;
+  double *cqc = P->cq, *cqs = P->dq, *cqt = P->p1w;
+  double *uc = P->W, *us = P->W + n, *ut = P->Q;
+  double *cp = P->cp;
   dm_lag_out o = {0, NULL, P->Lv + n, NULL, NULL, NULL};
   long k;
+  size_t i;
   int st = DM_OK, rc;
-  int cont = P->hist && memcmp(q, P->hq1, n * sizeof(double)) == 0
-             && memcmp(p, P->hp1, n * sizeof(double)) == 0;
+  int cont = P->hist && dm_same(q, P->hq1, n) && dm_same(p, P->hp1, n);
   *done = 0;
   if (!cont) {
-    memset(cq, 0, n * sizeof(double));
+    memset(P->cq, 0, n * sizeof(double));
     memset(cp, 0, n * sizeof(double));
     P->svf_valid = 0;
   }
   if (cont && P->svf_valid)
-    memcpy(f0, P->svf, n * sizeof(double));
+    dm_vcopy(f0, P->svf, n);
   else if ((st = force_at(P, q, f0, e)) != DM_OK)
     return st;
   P->hist = 0;
   P->svf_valid = 0;
   memset(P->v1w, 0, n * sizeof(double));
+  dm_vcopy(uc, P->X, n);           /* the last step's velocity, if any */
+  if (nsteps > 0)
+    drift(P, h, q, p, f0, cqc, qs, cqs, us, ph);
   for (k = 0; k < nsteps; k++) {
+    const int more = k + 1 < nsteps;
     int bad = 0;
     if (dm_interrupted()) {
       st = DM_EINTR;
       break;
     }
-    /* drift: u = M^{-1} (p + h/2 f0), q1 = q + h u, compensated */
-    for (i = 0; i < n; i++)
-      ph[i] = p[i] + hh * f0[i];
-    minv_mul(P, ph, u);
-    for (i = 0; i < n; i++) {
-      double y = h * u[i] - cq[i], t = q[i] + y;
-      cq[i] = (t - q[i]) - y;
-      q1[i] = t;
-    }
     o.Lq = f1;
-    if ((rc = sys->lagrangian(sys->data, q1, P->v1w, sys->par, DM_LAG_Q, &o, P->work)) != 0) {
-      st = dm_eval_lag(sys, q1, P->v1w, DM_LAG_Q, &o, P->work, e);   /* formats the message */
+    if ((rc = sys->lagrangian(sys->data, qs, P->v1w, sys->par, DM_LAG_Q, &o, P->work)) != 0) {
+      st = dm_eval_lag(sys, qs, P->v1w, DM_LAG_Q, &o, P->work, e);   /* formats the message */
       if (st == DM_OK)
         st = dm_err_set(e, rc > 0 ? DM_EDOM : DM_ECALLBACK, "force evaluation failed");
       break;
     }
-    /* kick: p1 = p + h/2 (f0 + f1), compensated; one finiteness test per step */
-    for (i = 0; i < n; i++) {
-      double y = hh * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
-      bad |= !isfinite(t) | !isfinite(q1[i]);
-      cp[i] = (t - p[i]) - y;
-      ph[i] = t;
+    /* kick: p1 = p + h/2 (f0 + f1), compensated, one finiteness test per
+     * step; then (unless this is the last step) the next drift from p1 */
+    if (kind != DM_MASS_FULL && more) {
+      for (i = 0; i < n; i++) {
+        double f = f1[i], y = hh * (f0[i] + f) - cp[i], t = p[i] + y, qi = qs[i];
+        bad |= !isfinite(t) | !isfinite(qi);
+        cp[i] = (t - p[i]) - y;
+        pn[i] = t;
+        qt[i] = drift1(kind, Mi[i * n + i], h, t + hh * f, qi, cqs[i], cqt + i, ut + i);
+      }
+    } else {
+      for (i = 0; i < n; i++) {
+        double y = hh * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
+        bad |= !isfinite(t) | !isfinite(qs[i]);
+        cp[i] = (t - p[i]) - y;
+        pn[i] = t;
+      }
+      if (more)
+        drift(P, h, qs, pn, f1, cqs, qt, cqt, ut, ph);
     }
     if (bad) {
       st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
       break;
     }
     for (i = 0; i < n; i++) {
-      q[i] = q1[i];
-      p[i] = ph[i];
+      q[i] = qs[i];
+      p[i] = pn[i];
     }
-    tmp = f0;
-    f0 = f1;
-    f1 = tmp;
+    tmp = f0, f0 = f1, f1 = tmp;
+    tmp = qs, qs = qt, qt = tmp;
+    tmp = cqc, cqc = cqs, cqs = cqt, cqt = tmp;
+    tmp = uc, uc = us, us = ut, ut = tmp;
   }
   *done = k;
   if (stt) {
@@ -292,12 +345,16 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
     stt->residual = 0.0;
   }
   if (st == DM_OK || st == DM_EINTR) {
-    /* history for the next call: continuation, carries, FSAL force */
-    memcpy(P->hq1, q, n * sizeof(double));
-    memcpy(P->hp1, p, n * sizeof(double));
-    memcpy(P->svf, f0, n * sizeof(double));
-    memcpy(P->X + n, u, n * sizeof(double));
-    memcpy(P->hV, P->X, 2 * n * sizeof(double));
+    /* history for the next call: continuation, carries, FSAL force, the
+     * last step's stage velocities */
+    if (cqc != P->cq)
+      dm_vcopy(P->cq, cqc, n);
+    dm_vcopy(P->hq1, q, n);
+    dm_vcopy(P->hp1, p, n);
+    dm_vcopy(P->svf, f0, n);
+    dm_vcopy(P->X, uc, n);
+    dm_vcopy(P->X + n, uc, n);
+    dm_vcopy(P->hV, P->X, 2 * n);
     P->hist = 1;
     P->svf_valid = 1;
   }
