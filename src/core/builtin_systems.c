@@ -48,19 +48,28 @@ static int setup(dm_system *s, const char *name, size_t n, size_t m, const char 
   return DM_OK;
 }
 
-static void kinetic(size_t n, const double *v, unsigned what, dm_lag_out *o, double *T)
+/* T = |v|^2 / 2 (only when L is asked for), Lv = v, Lvv = I, Lvq = 0. */
+static inline void kinetic(size_t n, const double *v, unsigned what, dm_lag_out *o, double *T)
 {
   size_t i;
-  *T = 0.0;
-  for (i = 0; i < n; i++)
-    *T += 0.5 * v[i] * v[i];
+  if (what & DM_LAG_L) {
+    double s = 0.0;
+    for (i = 0; i < n; i++)
+      s += v[i] * v[i];
+    *T = 0.5 * s;               /* = the sum of v_i^2 / 2: halving is exact */
+  }
   if (what & DM_LAG_V)
-    memcpy(o->Lv, v, n * sizeof(double));
-  if (what & DM_LAG_VV)
+    for (i = 0; i < n; i++)
+      o->Lv[i] = v[i];
+  if (what & DM_LAG_VV) {
     for (i = 0; i < n * n; i++)
-      o->Lvv[i] = (i / n == i % n) ? 1.0 : 0.0;
+      o->Lvv[i] = 0.0;
+    for (i = 0; i < n; i++)
+      o->Lvv[i * n + i] = 1.0;
+  }
   if (what & DM_LAG_VQ)
-    memset(o->Lvq, 0, n * n * sizeof(double));
+    for (i = 0; i < n * n; i++)
+      o->Lvq[i] = 0.0;
 }
 
 /* {==== harmonic oscillator, pendulum, damped oscillator ================= */
@@ -68,7 +77,7 @@ static void kinetic(size_t n, const double *v, unsigned what, dm_lag_out *o, dou
 static int harmonic_lag(void *data, const double *q, const double *v, const double *par,
                         unsigned what, dm_lag_out *o, void *work)
 {
-  double w2 = par[0] * par[0], T;
+  double w2 = par[0] * par[0], T = 0.0;
   (void)data;
   (void)work;
   kinetic(1, v, what, o, &T);
@@ -84,7 +93,7 @@ static int harmonic_lag(void *data, const double *q, const double *v, const doub
 static int pendulum_lag(void *data, const double *q, const double *v, const double *par,
                         unsigned what, dm_lag_out *o, void *work)
 {
-  double T;
+  double T = 0.0;
   (void)data;
   (void)work;
   kinetic(1, v, what, o, &T);
@@ -141,27 +150,31 @@ int dm_builtin_damped_oscillator(dm_system *s, double omega, double c, dm_err *e
 
 /* {==== Kepler and J2 ==================================================== */
 
-static int kepler_lag_n(size_t n, const double *q, const double *v, const double *par,
-                        unsigned what, dm_lag_out *o)
+static inline int kepler_lag_n(size_t n, const double *q, const double *v, const double *par,
+                               unsigned what, dm_lag_out *o)
 {
-  double r2 = 0.0, r, r3, T, mu = par[0];
+  double r2 = 0.0, r, ir3, k, T = 0.0, mu = par[0];
   size_t i, j;
   for (i = 0; i < n; i++)
     r2 += q[i] * q[i];
   if (!(r2 > 0.0))
     return 1;
   r = sqrt(r2);
-  r3 = r2 * r;
   kinetic(n, v, what, o, &T);
   if (what & DM_LAG_L)
     o->L = T + mu / r;
+  /* -mu q / r^3 with one division: k = -mu / r^3 */
+  ir3 = 1.0 / (r2 * r);
+  k = -mu * ir3;
   if (what & DM_LAG_Q)
     for (i = 0; i < n; i++)
-      o->Lq[i] = -mu * q[i] / r3;
-  if (what & DM_LAG_QQ)
+      o->Lq[i] = k * q[i];
+  if (what & DM_LAG_QQ) {
+    double c = 3.0 * mu * ir3 / r2;       /* Lqq = k I + 3 mu q q^T / r^5 */
     for (i = 0; i < n; i++)
       for (j = 0; j < n; j++)
-        o->Lqq[i * n + j] = -mu * ((i == j) / r3 - 3.0 * q[i] * q[j] / (r3 * r2));
+        o->Lqq[i * n + j] = c * (q[i] * q[j]) + (i == j ? k : 0.0);
+  }
   return 0;
 }
 
@@ -203,7 +216,7 @@ static int j2_lag(void *data, const double *q, const double *v, const double *pa
                   unsigned what, dm_lag_out *o, void *work)
 {
   double J2 = par[0], z = q[2], r2 = q[0] * q[0] + q[1] * q[1] + z * z, r, ir, ir2, ir3, ir5, ir7;
-  double T, A, B;
+  double T = 0.0, A, B;
   size_t i, j;
   (void)data;
   (void)work;
@@ -253,7 +266,7 @@ int dm_builtin_j2(dm_system *s, double J2, dm_err *e)
 static int sph_r3_lag(void *data, const double *q, const double *v, const double *par,
                       unsigned what, dm_lag_out *o, void *work)
 {
-  double T;
+  double T = 0.0;
   (void)data;
   (void)work;
   kinetic(3, v, what, o, &T);
