@@ -1,18 +1,25 @@
 /* smalllu.h -- dense LU with partial pivoting for the small Newton systems
  * of the integrators and the reduction (stage equations, SHAKE, momentum
- * projections, Legendre maps: n from 1 to a few dozen).
+ * projections, Legendre maps: n from 1 to about a hundred).
  *
  * Why not GSL here.  STYLE.md asks for GSL's linear algebra; small kernels
  * are the exception when measured.  GSL 2.7's gsl_linalg_LU_decomp is the
  * blocked (level-3) algorithm: for a 6 x 6 system it goes through views,
  * cblas_dtrsv/dger/idamax calls and mallocs and frees a pivot vector on
  * every call.  In the J2 Gauss-2 benchmark (6 x 6 Newton matrix; perf) the
- * GSL LU and solve were ~35% of a step and malloc/free ~2%.  Factor + solve,
- * this kernel against GSL (thread CPU time, same machine): n = 3: 60 vs
- * 269 ns, n = 6: 187 vs 487 ns, n = 9: 515 vs 1104 ns, n = 16: 2.3 vs
- * 3.3 us; the two are even around n = 24..48 and GSL's blocked code wins
- * by ~20% from n = 64.  Same pivots as GSL, and L and U equal to GSL's
- * to round-off (tests/c/test_smalllu.c).  Above DM_SMALLLU_NMAX the calls go to
+ * GSL LU and solve were ~35% of a step and malloc/free ~2%.  Factor + solve
+ * of a random diagonally dominant matrix (copy included), this kernel
+ * against GSL with gslcblas (thread CPU time, median of 9, same machine,
+ * one run): n = 6: 0.21 vs 0.64 us, 9: 0.61 vs 1.29, 16: 2.6 vs 3.2,
+ * 24: 8.0 vs 7.8, 32: 17 vs 17, 48: 49 vs 47, 64: 101 vs 99, 96: 307 vs
+ * 275, 128: 744 vs 695 us (within 12% up to n = 128); from n = 160 GSL's
+ * blocked code is ~1.6x faster (160: 2.26 vs 1.41 ms, 256: 9.1 vs 5.6 ms)
+ * -- the kernel's rank-1 updates stream the whole trailing matrix through
+ * the cache at every elimination step.  Hence DM_SMALLLU_NMAX = 128: no
+ * Newton system of a realistic step (Gauss 8 on 16 coordinates) allocates,
+ * and where GSL's malloc comes back the factorisation costs milliseconds.
+ * Same pivots as GSL, and L and U equal to GSL's to round-off
+ * (tests/c/test_smalllu.c).  Above DM_SMALLLU_NMAX the calls go to
  * gsl_linalg_LU_decomp / gsl_linalg_LU_svx unchanged.
  *
  * Storage.  a is row-major n x n, factored in place: the unit lower factor
@@ -40,7 +47,7 @@
 #include <stddef.h>
 
 /* Sizes up to this use the kernel in smalllu.c, larger ones GSL. */
-#define DM_SMALLLU_NMAX 32
+#define DM_SMALLLU_NMAX 128
 
 int dm_smalllu_factor(double *a, size_t n, size_t *perm);
 

@@ -140,7 +140,7 @@ static void check_steps(const char *label, const dm_system *sys, const char *met
   dm_integ_opts o;
   dm_integrator *I = NULL;
   dm_err e;
-  double q[8], p[8];
+  double q[16], p[16];
   size_t n = sys->n;
   long k, na, nb;
   int st = DM_OK;
@@ -196,6 +196,62 @@ static void test_builtin(void)
   dm_system_release(&kep);
   dm_system_release(&sph);
   dm_system_release(&damp);
+}
+
+/* A chain of 9 anharmonic oscillators, L = |v|^2/2 - sum (k q_i^2/2 +
+ * q_i^4/4) - c sum q_i q_{i+1}: Gauss 4 on it has 36 unknowns (above the
+ * small LU's former limit of 32, where GSL allocated per factorisation). */
+static int chain_lag(void *data, const double *q, const double *v, const double *par,
+                     unsigned what, dm_lag_out *o, void *work)
+{
+  const double k = 2.385, c = 0.3;
+  size_t i, j;
+  (void)data;
+  (void)par;
+  (void)work;
+  if (what & DM_LAG_L) {
+    o->L = 0.0;
+    for (i = 0; i < 9; i++)
+      o->L += 0.5 * v[i] * v[i] - 0.5 * k * q[i] * q[i] - 0.25 * q[i] * q[i] * q[i] * q[i]
+              - (i + 1 < 9 ? c * q[i] * q[i + 1] : 0.0);
+  }
+  for (i = 0; i < 9; i++) {
+    if (what & DM_LAG_Q)
+      o->Lq[i] = -k * q[i] - q[i] * q[i] * q[i] - (i > 0 ? c * q[i - 1] : 0.0)
+                 - (i + 1 < 9 ? c * q[i + 1] : 0.0);
+    if (what & DM_LAG_V)
+      o->Lv[i] = v[i];
+    for (j = 0; j < 9; j++) {
+      if (what & DM_LAG_VV)
+        o->Lvv[i * 9 + j] = i == j ? 1.0 : 0.0;
+      if (what & DM_LAG_VQ)
+        o->Lvq[i * 9 + j] = 0.0;
+      if (what & DM_LAG_QQ)
+        o->Lqq[i * 9 + j] = i == j ? -k - 3.0 * q[i] * q[i]
+                            : (i == j + 1 || j == i + 1) ? -c : 0.0;
+    }
+  }
+  return 0;
+}
+
+static void test_chain(void)
+{
+  static const double M[81] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0,
+                               0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0,
+                               0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0,
+                               0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
+  const double q0[9] = {0.7, -0.3, 0.2, 0.5, -0.6, 0.1, 0.4, -0.2, 0.3};
+  const double p0[9] = {0.2, 0.1, -0.4, 0.3, 0.0, -0.1, 0.25, 0.15, -0.3};
+  dm_system sys;
+  memset(&sys, 0, sizeof sys);
+  sys.name = "oscillator chain";
+  sys.n = 9;
+  sys.flags = DM_SYS_SEPARABLE | DM_SYS_MECHANICAL;
+  sys.mass = M;
+  sys.lagrangian = chain_lag;
+  check_steps("9-oscillator chain Gauss 4 (36 unknowns)", &sys, "gauss", 4, 1, 0.05, q0, p0);
+  check_steps("9-oscillator chain Gauss 8 (72 unknowns), full Newton", &sys, "gauss", 8, 0, 0.1,
+              q0, p0);
 }
 
 /* J2 traced from expressions, evaluated by the tape */
@@ -463,6 +519,7 @@ int main(void)
 #endif
   test_counter_works();
   test_builtin();
+  test_chain();
   test_traced();
   test_reduced();
   test_verlet_mass();
