@@ -18,7 +18,7 @@
 #include "core/status.h"
 #include "tap.h"
 
-#define NM 48
+#define NM (DM_SMALLLU_NMAX + 8)
 
 static gsl_rng *rng;
 
@@ -107,12 +107,16 @@ static void ipiv_to_rows(const size_t *perm, size_t n, size_t *rows)
 
 static void test_random(void)
 {
-  double A[NM * NM], lu[NM * NM], lug[NM * NM], b[NM], x[NM], xg[NM];
-  size_t perm[NM], pg[NM], rows[NM];
+  static double A[NM * NM], lu[NM * NM], lug[NM * NM], b[NM], x[NM], xg[NM];
+  static size_t perm[NM], pg[NM], rows[NM];
   double worst_x = 0.0, worst_bw = 0.0, worst_lu = 0.0;
   int bad_perm = 0, bad_status = 0;
-  for (size_t n = 1; n <= 40; n++)
-    for (int rep = 0; rep < 8; rep++) {
+  /* 1 .. 40, then sizes around DM_SMALLLU_NMAX (both kernels) */
+  static const size_t big[] = {64, 100, DM_SMALLLU_NMAX - 1, DM_SMALLLU_NMAX,
+                               DM_SMALLLU_NMAX + 1, DM_SMALLLU_NMAX + 8};
+  for (size_t t = 0; t < 40 + sizeof big / sizeof big[0]; t++)
+    for (int rep = 0; rep < (t < 40 ? 8 : 2); rep++) {
+      size_t n = t < 40 ? t + 1 : big[t - 40];
       random_matrix(A, n, rep % 2);
       random_vector(b, n);
       if (small_solve(A, b, n, x, lu, perm) != DM_OK || gsl_solve(A, b, n, xg, lug, pg) != 0) {
@@ -131,7 +135,7 @@ static void test_random(void)
         worst_lu = fmax(worst_lu, rel_diff(lu, lug, n * n));
       }
     }
-  tap_is_int(bad_status, 0, "random 1x1 .. 40x40: every factorisation succeeds");
+  tap_is_int(bad_status, 0, "random 1x1 .. 40x40 and 64 .. %d: every factorisation succeeds", DM_SMALLLU_NMAX + 8);
   tap_ok(worst_x <= 1e-13, "random: solution = GSL's to %.2g (<= 1e-13)", worst_x);
   tap_ok(worst_bw <= 1.0, "random: backward error %.2g n eps (<= 1)", worst_bw);
   tap_is_int(bad_perm, 0, "random n <= %d: the same row interchanges as GSL", DM_SMALLLU_NMAX);
@@ -143,8 +147,8 @@ static void test_random(void)
  * backward stable, and as close to GSL as the conditioning allows. */
 static void test_ill_conditioned(void)
 {
-  double A[NM * NM], lu[NM * NM], lug[NM * NM], b[NM], x[NM], xg[NM];
-  size_t perm[NM], pg[NM];
+  static double A[NM * NM], lu[NM * NM], lug[NM * NM], b[NM], x[NM], xg[NM];
+  static size_t perm[NM], pg[NM];
   double worst_bw = 0.0, worst_fw = 0.0, xone = 0.0;
   for (size_t n = 4; n <= 10; n++) {
     for (size_t i = 0; i < n; i++)
@@ -195,8 +199,8 @@ static void test_ill_conditioned(void)
 /* Matrices that elimination without interchanges gets wrong or cannot do. */
 static void test_pivoting(void)
 {
-  double lu[NM * NM], x[NM];
-  size_t perm[NM];
+  static double lu[NM * NM], x[NM];
+  static size_t perm[NM];
   {
     const double A[4] = {0.0, 2.385, 1.5, 0.0}, b[2] = {4.77, 3.0};
     tap_is_int(small_solve(A, b, 2, x, lu, perm), DM_OK, "zero leading entry: factors");
@@ -252,8 +256,8 @@ static void test_pivoting(void)
 
 static void test_singular(void)
 {
-  double A[NM * NM], lu[NM * NM], x[NM], b[NM];
-  size_t perm[NM];
+  static double A[NM * NM], lu[NM * NM], x[NM], b[NM];
+  static size_t perm[NM];
   size_t sizes[] = {3, 7, DM_SMALLLU_NMAX, DM_SMALLLU_NMAX + 5};
   for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
     size_t n = sizes[t];
@@ -299,8 +303,9 @@ static void test_singular(void)
 
 static void test_nonfinite(void)
 {
-  double A[NM * NM], lu[NM * NM];
-  size_t perm[NM], sizes[] = {1, 5, DM_SMALLLU_NMAX + 1};
+  static double A[NM * NM], lu[NM * NM];
+  static size_t perm[NM];
+  size_t sizes[] = {1, 5, DM_SMALLLU_NMAX + 1};
   for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
     size_t n = sizes[t];
     for (int kind = 0; kind < 3; kind++) {
