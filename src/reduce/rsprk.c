@@ -25,6 +25,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -44,6 +45,75 @@ static void kahan(size_t n, const double *x0, const double *dx, double *carry, d
     carry[i] = (t - x0[i]) - y;
     out[i] = t;
   }
+}
+
+/* Inline helpers of the hot path (the vectors are a few entries long: a
+ * call to memcpy / memcmp / a norm loop costs more than the work). */
+static inline void vcopy(double *y, const double *x, size_t n)
+{
+  size_t i;
+  for (i = 0; i < n; i++)
+    y[i] = x[i];
+}
+
+static inline int vsame(const double *x, const double *y, size_t n)
+{
+  size_t i;
+  for (i = 0; i < n; i++) {
+    uint64_t a, b;
+    memcpy(&a, x + i, sizeof a);
+    memcpy(&b, y + i, sizeof b);
+    if (a != b)
+      return 0;
+  }
+  return 1;
+}
+
+/* max(a, b), NaN when either is (fmax drops NaNs and is a libm call) */
+static inline double max2(double a, double b)
+{
+  return a > b || a != a ? a : b;
+}
+
+/* max |x_i|, NaN when some x_i is NaN or infinite (dm_rnorm_inf's
+ * contract), with two independent max chains and no branch per entry */
+static inline double norm_inf(const double *x, size_t n)
+{
+  double m0 = 0.0, m1 = 0.0, z0 = 0.0, z1 = 0.0;
+  size_t i;
+  for (i = 0; i + 1 < n; i += 2) {
+    double a = fabs(x[i]), b = fabs(x[i + 1]);
+    m0 = a > m0 ? a : m0;
+    m1 = b > m1 ? b : m1;
+    z0 += x[i] * 0.0;           /* NaN iff x_i is NaN or infinite */
+    z1 += x[i + 1] * 0.0;
+  }
+  if (i < n) {
+    double a = fabs(x[i]);
+    m0 = a > m0 ? a : m0;
+    z0 += x[i] * 0.0;
+  }
+  return z0 + z1 == 0.0 ? (m0 > m1 ? m0 : m1) : NAN;
+}
+
+/* 1 when every x_i is finite: a sum of finite numbers is finite unless it
+ * overflows, and only then are the entries looked at one by one */
+static inline int all_finite(const double *x, size_t n)
+{
+  double s0 = 0.0, s1 = 0.0;
+  size_t i;
+  for (i = 0; i + 1 < n; i += 2) {
+    s0 += x[i];
+    s1 += x[i + 1];
+  }
+  if (i < n)
+    s0 += x[i];
+  if (fabs(s0 + s1) <= DBL_MAX)
+    return 1;
+  for (i = 0; i < n; i++)
+    if (!(fabs(x[i]) <= DBL_MAX))
+      return 0;
+  return 1;
 }
 
 int dm_routh_check_inertia(const dm_routh *red, const double *x, double *ref, double *work,
@@ -186,27 +256,26 @@ static int cb_fail(dm_rsprk *P, int st, const char *what, const double *x, dm_er
 static int eval_gyro(dm_rsprk *P, size_t i, const double *x, const double *v, int jac, dm_err *e)
 {
   const dm_routh *red = P->red;
-  size_t d = P->d, dd = P->dd, k;
+  size_t d = P->d, dd = P->dd;
   const dm_rprog *pg = jac ? &red->gyro_j : &red->gyro_r;
   double *o = P->tout;
-  memcpy(P->tin, x, d * sizeof(double));
-  memcpy(P->tin + d, v, d * sizeof(double));
+  vcopy(P->tin, x, d);
+  vcopy(P->tin + d, v, d);
   dm_rprog_run(pg, P->tin, red->par, o, P->twork);
-  for (k = 0; k < pg->nout; k++)
-    if (!isfinite(o[k]))
-      return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", x, e);
-  memcpy(P->ga + i * d, o, d * sizeof(double));
+  if (!all_finite(o, pg->nout))
+    return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", x, e);
+  vcopy(P->ga + i * d, o, d);
   if (!jac) {
-    memcpy(P->gkv + i * d, o + d, d * sizeof(double));
-    memcpy(P->gib + i * d, o + 2 * d, d * sizeof(double));
+    vcopy(P->gkv + i * d, o + d, d);
+    vcopy(P->gib + i * d, o + 2 * d, d);
     return DM_OK;
   }
-  memcpy(P->gK + i * dd, o + d, dd * sizeof(double));
-  memcpy(P->gB + i * dd, o + d + dd, dd * sizeof(double));
-  memcpy(P->gkv + i * d, o + d + 2 * dd, d * sizeof(double));
-  memcpy(P->gib + i * d, o + 2 * d + 2 * dd, d * sizeof(double));
-  memcpy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd * sizeof(double));
-  memcpy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd * sizeof(double));
+  vcopy(P->gK + i * dd, o + d, dd);
+  vcopy(P->gB + i * dd, o + d + dd, dd);
+  vcopy(P->gkv + i * d, o + d + 2 * dd, d);
+  vcopy(P->gib + i * d, o + 2 * d + 2 * dd, d);
+  vcopy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd);
+  vcopy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd);
   return DM_OK;
 }
 
@@ -216,13 +285,13 @@ static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, double 
   const dm_routh *red = P->red;
   size_t d = P->d, dd = P->dd, k;
   double *o = P->tout;
-  memcpy(P->tin, x, d * sizeof(double));
-  memset(P->tin + d, 0, d * sizeof(double));
+  vcopy(P->tin, x, d);
+  for (k = 0; k < d; k++)
+    P->tin[d + k] = 0.0;
   dm_rprog_run(K ? &red->gyro_j : &red->gyro_r, P->tin, red->par, o, P->twork);
-  for (k = 0; k < (K ? red->gyro_j.nout : d); k++)
-    if (!isfinite(o[k]))
-      return cb_fail(P, 1, "the connection mu^T A", x, e);
-  memcpy(a, o, d * sizeof(double));
+  if (!all_finite(o, K ? red->gyro_j.nout : d))
+    return cb_fail(P, 1, "the connection mu^T A", x, e);
+  vcopy(a, o, d);
   if (K)
     memcpy(K, o + d, dd * sizeof(double));
   if (B)
@@ -230,19 +299,22 @@ static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, double 
   return DM_OK;
 }
 
+/* R^mu (no value: the step never needs it), the reduced force and the
+ * connection terms at stage i; Sdot, and D, E when jac.  Terms that are
+ * identically zero (no force, no gyroscopic part) are not added. */
 static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
 {
   const dm_system *sys = P->sys;
   const double *par = P->red->par;
-  size_t d = P->d, dd = P->dd, a, b;
+  const size_t d = P->d, dd = P->dd;
+  size_t a, b;
   double *Xi = P->Xs + i * d, *Vi = P->X + i * d;
   dm_lag_out o = {0, P->Lq + i * d, P->Lv + i * d, P->Lvv + i * dd, P->Lvq + i * dd,
                   P->Lqq + i * dd};
-  unsigned what = DM_LAG_L | DM_LAG_Q | DM_LAG_V | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
+  unsigned what = DM_LAG_Q | DM_LAG_V | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
   int st = sys->lagrangian(sys->data, Xi, Vi, par, what, &o, P->work);
   if (st != 0)
     return cb_fail(P, st, "the Routhian", Xi, e);
-  P->Lval[i] = o.L;
   if (P->forced) {
     unsigned fw = DM_FORCE_F | (jac ? (DM_FORCE_Q | DM_FORCE_V) : 0u);
     st = sys->force(sys->data, Xi, Vi, par, fw, P->F + i * d, P->Fq + i * dd, P->Fv + i * dd, P->work);
@@ -251,77 +323,130 @@ static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
   }
   if (P->gyro && (st = eval_gyro(P, i, Xi, Vi, jac, e)) != DM_OK)
     return st;
-  for (a = 0; a < d; a++)
-    P->Sdot[i * d + a] = P->Lq[i * d + a] - P->gib[i * d + a] + P->F[i * d + a];
-  if (jac)
+  {
+    const double *restrict Lq = P->Lq + i * d, *restrict gib = P->gib + i * d;
+    const double *restrict F = P->F + i * d;
+    double *restrict Sd = P->Sdot + i * d;
+    for (a = 0; a < d; a++) {
+      double v = Lq[a];
+      if (P->gyro)
+        v -= gib[a];
+      if (P->forced)
+        v += F[a];
+      Sd[a] = v;
+    }
+  }
+  if (jac) {
+    const size_t k0 = i * dd;
+    const double *restrict Lqq = P->Lqq + k0, *restrict Lvq = P->Lvq + k0;
+    const double *restrict gdib = P->gdib + k0, *restrict gdkv = P->gdkv + k0;
+    const double *restrict gB = P->gB + k0, *restrict gK = P->gK + k0;
+    const double *restrict Fq = P->Fq + k0, *restrict Fv = P->Fv + k0;
+    double *restrict D = P->D + k0, *restrict E = P->E + k0;
     for (a = 0; a < d; a++)
       for (b = 0; b < d; b++) {
-        size_t k = i * dd + a * d + b;
-        P->D[k] = P->Lqq[k] - P->gdib[k] + P->Fq[k] + P->gdkv[k];
-        P->E[k] = P->Lvq[i * dd + b * d + a] - P->gB[i * dd + b * d + a] + P->Fv[k] + P->gK[k];
+        size_t k = a * d + b, t = b * d + a;
+        double x = Lqq[k], y = Lvq[t];
+        if (P->gyro) {
+          x -= gdib[k];
+          y -= gB[t];
+        }
+        if (P->forced) {
+          x += Fq[k];
+          y += Fv[k];
+        }
+        if (P->gyro) {
+          x += gdkv[k];
+          y += gK[k];
+        }
+        D[k] = x;
+        E[k] = y;
       }
+  }
   return DM_OK;
 }
 
 /* Residual (and the Newton matrix when jac) of the stage equations. */
 static int assemble(dm_rsprk *P, double h, const double *x0, const double *s0, int jac, dm_err *e)
 {
-  size_t d = P->d, S = P->S, dd = P->dd, N = P->N, i, j, k, a, c;
+  const size_t d = P->d, S = P->S, dd = P->dd, N = P->N;
   const double *A = P->tab->a, *At = P->tab->at;
+  size_t i, j, k, a, c;
   int st;
-  for (i = 0; i < S; i++)
-    for (a = 0; a < d; a++) {
-      double acc = 0.0;
-      for (j = 0; j < S; j++)
-        acc += A[i * S + j] * P->X[j * d + a];
-      P->Xs[i * d + a] = x0[a] + h * acc;
-    }
+  {
+    const double *restrict X = P->X;     /* restrict in these blocks only: */
+    double *restrict Xs = P->Xs;         /* the stage evaluation writes P */
+    for (i = 0; i < S; i++)
+      for (a = 0; a < d; a++) {
+        double acc = 0.0;
+        for (j = 0; j < S; j++)
+          acc += A[i * S + j] * X[j * d + a];
+        Xs[i * d + a] = x0[a] + h * acc;
+      }
+  }
   for (i = 0; i < S; i++)
     if ((st = eval_stage(P, i, jac, e)) != DM_OK)
       return st;
-  for (i = 0; i < S; i++)
-    for (a = 0; a < d; a++) {
-      double sd = 0.0, kv = 0.0;
-      for (j = 0; j < S; j++) {
-        sd += At[i * S + j] * P->Sdot[j * d + a];
-        kv += At[i * S + j] * P->gkv[j * d + a];
+  {
+    const double *restrict Sdot = P->Sdot, *restrict gkv = P->gkv, *restrict ga = P->ga;
+    const double *restrict Lv = P->Lv, *restrict a0 = P->a0;
+    double *restrict R = P->R;
+    for (i = 0; i < S; i++)
+      for (a = 0; a < d; a++) {
+        double sd = 0.0, kv = 0.0;
+        for (j = 0; j < S; j++) {
+          sd += At[i * S + j] * Sdot[j * d + a];
+          kv += At[i * S + j] * gkv[j * d + a];
+        }
+        /* S_i = s0 + h sum at Sd + [h sum at K V - (muA(X_i) - muA(x0))] */
+        R[i * d + a] = Lv[i * d + a] - (s0[a] + h * sd + (h * kv - (ga[i * d + a] - a0[a])));
       }
-      /* S_i = s0 + h sum at Sd + [h sum at K V - (muA(X_i) - muA(x0))] */
-      P->R[i * d + a] = P->Lv[i * d + a] - (s0[a] + h * sd + (h * kv - (P->ga[i * d + a] - P->a0[a])));
-    }
+  }
   if (jac) {
-    memset(P->Jm, 0, N * N * sizeof(double));
+    /* each entry accumulated in a register, the h^2 at_ij a_jk hoisted;
+     * the stage blocks fill the matrix unless there are multipliers */
+    const double *restrict Lvq = P->Lvq, *restrict gK = P->gK, *restrict E = P->E;
+    const double *restrict Lvv = P->Lvv, *restrict D = P->D;
+    double *restrict Jm = P->Jm, cj[DM_TABLEAU_SMAX];
+    if (N > P->Sd)
+      memset(Jm, 0, N * N * sizeof(double));
     for (i = 0; i < S; i++)
       for (k = 0; k < S; k++) {
-        double hak = h * A[i * S + k], hatk = h * At[i * S + k];
-        double *Jb = P->Jm + (i * d) * N + k * d;
+        const double hak = h * A[i * S + k], hatk = h * At[i * S + k];
+        double *Jb = Jm + (i * d) * N + k * d;
+        for (j = 0; j < S; j++)
+          cj[j] = h * h * At[i * S + j] * A[j * S + k];
         for (a = 0; a < d; a++)
           for (c = 0; c < d; c++) {
-            double v = hak * (P->Lvq[i * dd + a * d + c] + P->gK[i * dd + a * d + c])
-                       - hatk * P->E[k * dd + a * d + c];
+            const size_t ac = a * d + c;
+            double v = hak * (Lvq[i * dd + ac] + gK[i * dd + ac]) - hatk * E[k * dd + ac];
             if (i == k)
-              v += P->Lvv[i * dd + a * d + c];
+              v += Lvv[i * dd + ac];
             for (j = 0; j < S; j++)
-              v -= h * h * At[i * S + j] * A[j * S + k] * P->D[j * dd + a * d + c];
+              v -= cj[j] * D[j * dd + ac];
             Jb[a * N + c] = v;
           }
       }
+    P->lvv_norm = norm_inf(P->Lvv, S * dd);   /* Lvv changes only with the Jacobian */
   }
   if (P->m)
     return dm_rsprk_constr_assemble(P, h, x0, jac, e);
   return DM_OK;
 }
 
-static double update_norm(const dm_rsprk *P, double h, const double *s0)
+/* Scaled size of the Newton update: rv and xv are max |R| and max |X| over
+ * the velocities (from the update pass); the multipliers relative to
+ * max(|x|, momentum scale). */
+static double update_norm(const dm_rsprk *P, double h, const double *s0, double rv, double xv)
 {
   size_t Sd = P->Sd, N = P->N;
-  double ms = dm_rnorm_inf(s0, P->d) + fabs(h) * dm_rnorm_inf(P->Sdot, Sd);
-  double lv = dm_rnorm_inf(P->Lvv, P->S * P->dd);
-  double vs = fmax(fmax(dm_rnorm_inf(P->X, Sd), lv > 0 ? ms / lv : 0.0), DBL_MIN);
-  double dn = dm_rnorm_inf(P->R, Sd) / vs;
+  double ms = norm_inf(s0, P->d) + fabs(h) * norm_inf(P->Sdot, Sd);
+  double lv = P->lvv_norm;
+  double vs = max2(max2(xv, lv > 0 ? ms / lv : 0.0), DBL_MIN);
+  double dn = rv / vs;
   if (N > Sd) {
-    double xs = fmax(fmax(dm_rnorm_inf(P->X + Sd, N - Sd), ms), DBL_MIN);
-    dn = fmax(dn, dm_rnorm_inf(P->R + Sd, N - Sd) / xs);
+    double xs = max2(max2(norm_inf(P->X + Sd, N - Sd), ms), DBL_MIN);
+    dn = max2(dn, norm_inf(P->R + Sd, N - Sd) / xs);
   }
   return dn;
 }
@@ -350,7 +475,7 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
   for (it = 1; it <= P->maxiter; it++) {
     if ((st = assemble(P, h, x0, s0, jac, e)) != DM_OK)
       return explain(P, st, e);
-    rn = dm_rnorm_inf(P->R, N);
+    rn = norm_inf(P->R, N);
     if (!isfinite(rn))
       return explain(P, dm_err_set(e, DM_EDOM, "RSPRK: non-finite residual in the stage equations "
                                    "(h = %g, iteration %d)", h, it), e);
@@ -364,9 +489,23 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
                                      : "; try a smaller step"), e);
     }
     dm_rlu_solve(&P->lu, P->Jm, N, P->R);
-    for (i = 0; i < N; i++)
-      P->X[i] -= P->R[i];
-    dn = update_norm(P, h, s0);
+    {
+      /* X -= R; max |R| and max |X| of the velocities on the way (NaN or
+       * Inf in either makes dn NaN: the test below catches it) */
+      double *X = P->X, rv = 0.0, xv = 0.0, z = 0.0;
+      const double *R = P->R;
+      for (i = 0; i < P->Sd; i++) {
+        double r = fabs(R[i]), x;
+        X[i] -= R[i];
+        x = fabs(X[i]);
+        rv = r > rv ? r : rv;
+        xv = x > xv ? x : xv;
+        z += R[i] * 0.0 + X[i] * 0.0;
+      }
+      for (; i < N; i++)
+        X[i] -= R[i];
+      dn = update_norm(P, h, s0, z == 0.0 ? rv : NAN, xv);
+    }
     if (!isfinite(dn))
       return explain(P, dm_err_set(e, DM_EDOM, "RSPRK: non-finite Newton update (h = %g)", h), e);
     if (dn <= P->tol) {
@@ -527,8 +666,8 @@ static void group_increment(dm_rsprk *P, double h, double *dtheta)
   for (a = 0; a < r; a++)
     dtheta[a] = 0.0;
   for (j = 0; j < P->S; j++) {
-    memcpy(P->tin, P->Xs + j * d, d * sizeof(double));
-    memcpy(P->tin + d, P->X + j * d, d * sizeof(double));
+    vcopy(P->tin, P->Xs + j * d, d);
+    vcopy(P->tin + d, P->X + j * d, d);
     dm_rprog_run(&red->thd, P->tin, red->par, P->thd, P->twork);
     for (a = 0; a < r; a++)
       dtheta[a] += h * P->tab->b[j] * P->thd[a];
@@ -539,8 +678,7 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
                   double *s1, double *dtheta, dm_integ_stats *stt, dm_err *e)
 {
   size_t d = P->d, i;
-  int cont = P->hist && memcmp(x0, P->hq1, d * sizeof(double)) == 0
-             && memcmp(s0, P->hp1, d * sizeof(double)) == 0;
+  int cont = P->hist && vsame(x0, P->hq1, d) && vsame(s0, P->hp1, d);
   int st;
   if (!cont) {
     memset(P->cq, 0, d * sizeof(double));
@@ -558,7 +696,7 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
   st = cont ? DM_OK : dm_routh_check_inertia(P->red, x0, &P->sing_ref, P->twork, "the initial point", e);
   if (st == DM_OK && P->gyro) {
     if (cont)
-      memcpy(P->a0, P->a1, d * sizeof(double));
+      vcopy(P->a0, P->a1, d);
     else
       st = eval_node(P, x0, P->a0, NULL, NULL, e);
   }
@@ -574,24 +712,23 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
     st = dm_routh_check_inertia(P->red, P->Xs + i * d, &P->sing_ref, P->twork, "a stage point", e);
   if (st == DM_OK)
     st = dm_routh_check_inertia(P->red, P->q1w, &P->sing_ref, P->twork, "the end point", e);
-  for (i = 0; st == DM_OK && i < d; i++)
-    if (!isfinite(P->q1w[i]) || !isfinite(P->p1w[i]))
-      st = dm_err_set(e, DM_EDOM, "RSPRK: the step produced a non-finite state (h = %g)", h);
+  if (st == DM_OK && !(all_finite(P->q1w, d) && all_finite(P->p1w, d)))
+    st = dm_err_set(e, DM_EDOM, "RSPRK: the step produced a non-finite state (h = %g)", h);
   if (st != DM_OK) {
     P->hist = 0;
     return st;
   }
   if (dtheta)
     group_increment(P, h, dtheta);
-  memcpy(P->hV, P->X, P->Sd * sizeof(double));
+  vcopy(P->hV, P->X, P->Sd);
   if (P->N > P->Sd)
-    memcpy(P->hx, P->X + P->Sd, (P->N - P->Sd) * sizeof(double));
-  memcpy(P->hq1, P->q1w, d * sizeof(double));
-  memcpy(P->hp1, P->p1w, d * sizeof(double));
+    vcopy(P->hx, P->X + P->Sd, P->N - P->Sd);
+  vcopy(P->hq1, P->q1w, d);
+  vcopy(P->hp1, P->p1w, d);
   P->hist_h = h;
   P->hist = 1;
-  memcpy(x1, P->q1w, d * sizeof(double));
-  memcpy(s1, P->p1w, d * sizeof(double));
+  vcopy(x1, P->q1w, d);
+  vcopy(s1, P->p1w, d);
   if (stt)
     stt->steps++;
   return DM_OK;

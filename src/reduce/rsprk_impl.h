@@ -29,6 +29,7 @@ struct dm_rsprk {
   double hist_h, E_ratio;
   double *hV, *hx, *hq1, *hp1, *Ex, *cq, *cp;
   double sing_ref;
+  double lvv_norm;               /* max |Lvv| over the stages, set with the Jacobian */
   dm_rlu lu, lu_small;           /* N; d + m (velocity / projection) */
   double *small;                 /* (d + m)^2 + (d + m) */
   double *tin, *tout, *twork;    /* program input (2d), outputs, tape work */
