@@ -141,6 +141,12 @@ typedef struct dm_legendre_ws {
   size_t *perm;
   double *vguess;                     /* last velocity (warm start) */
   int have_guess;
+  /* separable systems: v = M^{-1} p with the LU of sys->mass, refactored
+   * whenever sys->mass differs from the copy it was made from (parameters
+   * changed); unit mass: v = p */
+  double *Mcopy, *Mlu;                /* n*n each */
+  size_t *mperm;
+  int mass_state;                     /* 0: not factored, 1: unit, 2: LU */
   void *work;
 } dm_legendre_ws;
 

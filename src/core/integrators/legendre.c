@@ -17,9 +17,10 @@ dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
   double *d;
   if (w == NULL)
     return NULL;
-  /* Lq Lv F r vguess: 5n; Lvv Lvq Lqq Fq Fv A: 6 n*n; T: 2 n*n */
-  d = calloc(5 * n + 8 * n * n, sizeof(double));
-  w->perm = calloc(n, sizeof(size_t));
+  /* Lq Lv F r vguess: 5n; Lvv Lvq Lqq Fq Fv A: 6 n*n; T: 2 n*n; Mcopy Mlu:
+   * 2 n*n */
+  d = calloc(5 * n + 10 * n * n, sizeof(double));
+  w->perm = calloc(2 * n, sizeof(size_t));
   w->work = sys->work_size ? malloc(sys->work_size) : NULL;
   if (d == NULL || w->perm == NULL || (sys->work_size && w->work == NULL)) {
     free(d);
@@ -28,6 +29,7 @@ dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
     free(w);
     return NULL;
   }
+  w->mperm = w->perm + n;
   w->sys = sys;
   w->n = n;
   w->tol = 4.0 * DBL_EPSILON;
@@ -44,6 +46,8 @@ dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
   w->Fv = w->Fq + n * n;
   w->A = w->Fv + n * n;
   w->T = w->A + n * n;
+  w->Mcopy = w->T + 2 * n * n;
+  w->Mlu = w->Mcopy + n * n;
   return w;
 }
 
@@ -91,8 +95,41 @@ static int singular_lvv(const dm_system *sys, const double *q, const double *v, 
                     sys->name ? sys->name : "system");
 }
 
+/* v = M^{-1} p for a separable system (Lv = M v): the LU of the current
+ * mass matrix, refactored when it changed; for unit mass v = p.  The
+ * numbers are those of one Newton step from v = 0, which is what the
+ * general path computes from a zero guess. */
+static int separable_velocity(dm_legendre_ws *w, const double *p, double *v, dm_err *e)
+{
+  const double *M = w->sys->mass;
+  size_t n = w->n, nn = n * n, i;
+  if (w->mass_state == 0 || !dm_same(M, w->Mcopy, nn)) {
+    int unit = 1;
+    dm_vcopy(w->Mcopy, M, nn);
+    for (i = 0; i < nn; i++)
+      unit &= M[i] == (i % (n + 1) == 0 ? 1.0 : 0.0);
+    w->mass_state = unit ? 1 : 2;
+    if (!unit) {
+      dm_vcopy(w->Mlu, M, nn);
+      if (dm_smalllu_factor(w->Mlu, n, w->mperm) != DM_OK) {
+        w->mass_state = 0;
+        return dm_err_set(e, DM_ESINGULAR, "the mass matrix of '%s' is singular or not finite",
+                          w->sys->name ? w->sys->name : "system");
+      }
+    }
+  }
+  for (i = 0; i < n; i++)
+    v[i] = p[i];
+  if (w->mass_state == 2)
+    dm_smalllu_solve(w->Mlu, n, w->mperm, v);
+  for (i = 0; i < n; i++)
+    if (!isfinite(v[i]))
+      return dm_err_set(e, DM_EDOM, "velocity solve produced a non-finite value");
+  return DM_OK;
+}
+
 /* Newton on Lv(q, v) = p.  A mechanical L (linear Legendre map) needs one
- * iteration from any guess. */
+ * iteration from any guess; a separable one none (v = M^{-1} p). */
 int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
                          double *v, int guess, dm_err *e)
 {
@@ -101,6 +138,8 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
   int mech = (w->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
   double dprev = HUGE_VAL, d = HUGE_VAL;
   int it, st, stall = 0;
+  if ((w->sys->flags & DM_SYS_SEPARABLE) && w->sys->mass != NULL)
+    return separable_velocity(w, p, v, e);
   if (!guess)
     memset(v, 0, n * sizeof(double));
   for (it = 0; it < w->maxiter; it++) {
@@ -138,7 +177,23 @@ int dm_legendre_field(dm_legendre_ws *w, const double *q, const double *p,
 {
   size_t n = w->n, i;
   dm_lag_out o = {0, w->Lq, w->Lv, w->Lvv, w->Lvq, w->Lqq};
-  int st = dm_legendre_velocity(w, q, p, w->vguess, w->have_guess, e);
+  int st;
+  if ((w->sys->flags & DM_SYS_SEPARABLE) && w->sys->mass != NULL && qdot != p && pdot != q) {
+    /* qdot = M^{-1} p, pdot = Lq(q) (+ F) straight into the outputs */
+    if ((st = separable_velocity(w, p, qdot, e)) != DM_OK)
+      return st;
+    o.Lq = pdot;
+    if ((st = dm_eval_lag(w->sys, q, qdot, DM_LAG_Q, &o, w->work, e)) != DM_OK)
+      return st;
+    if (w->sys->force) {
+      if ((st = dm_eval_force(w->sys, q, qdot, DM_FORCE_F, w->F, NULL, NULL, w->work, e)) != DM_OK)
+        return st;
+      for (i = 0; i < n; i++)
+        pdot[i] += w->F[i];
+    }
+    return DM_OK;
+  }
+  st = dm_legendre_velocity(w, q, p, w->vguess, w->have_guess, e);
   if (st != DM_OK)
     return st;
   w->have_guess = 1;

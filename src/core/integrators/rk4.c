@@ -55,12 +55,15 @@ static int rk4_run(dm_integrator *I, double h, const double *q0, const double *p
   rk4_state *R = I->state;
   size_t n = I->n, N = 2 * n, i, a, b, c;
   int st;
-  memcpy(R->y, q0, n * sizeof(double));
-  memcpy(R->y + n, p0, n * sizeof(double));
+  dm_vcopy(R->y, q0, n);
+  dm_vcopy(R->y + n, p0, n);
   for (i = 0; i < 4; i++) {
     double *ki = R->k + i * N;
-    for (a = 0; a < N; a++)
-      R->Y[a] = R->y[a] + (i ? h * rk4_c[i] * R->k[(i - 1) * N + a] : 0.0);
+    if (i == 0)
+      dm_vcopy(R->Y, R->y, N);
+    else
+      for (a = 0; a < N; a++)
+        R->Y[a] = R->y[a] + h * rk4_c[i] * R->k[(i - 1) * N + a];
     if ((st = dm_legendre_field(I->leg, R->Y, R->Y + n, ki, ki + n, e)) != DM_OK)
       return st;
     if (DPhi) {
@@ -93,8 +96,8 @@ static int rk4_run(dm_integrator *I, double h, const double *q0, const double *p
       DPhi[a] = (a / N == a % N) + h * acc;
     }
   if (q1) {
-    memcpy(q1, R->Y, n * sizeof(double));
-    memcpy(p1, R->Y + n, n * sizeof(double));
+    dm_vcopy(q1, R->Y, n);
+    dm_vcopy(p1, R->Y + n, n);
   }
   I->stats.iters = 0;
   I->stats.steps++;
