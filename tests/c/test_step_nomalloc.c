@@ -504,6 +504,32 @@ static void test_verlet_mass(void)
       tap_ok(memcmp(qr, qs, sizeof qr) == 0 && memcmp(pr, ps, sizeof pr) == 0,
              "%s mass: run in chunks of 7 + 150 steps = 400 single steps (bitwise)", names[c]);
     }
+    /* compositions: the run loop's fused substeps = step() by step() */
+    for (int sc = 0; sc < 2; sc++) {
+      dm_integrator *Ic = NULL;
+      dm_integ_opts oc;
+      double qr[2], pr[2], qs[2], ps[2];
+      dm_integ_opts_init(&oc);
+      oc.order = sc ? 8 : 4;
+      if (dm_integrator_new(&sys, "composition", &oc, &Ic, NULL) != DM_OK) {
+        tap_ok(0, "%s mass: composition", names[c]);
+        continue;
+      }
+      memcpy(qr, q0, sizeof qr);
+      memcpy(pr, p0, sizeof pr);
+      memcpy(qs, q0, sizeof qs);
+      memcpy(ps, p0, sizeof ps);
+      dm_integrator_run(Ic, 0.0, qr, pr, h, 100, 7, NULL, NULL, NULL, NULL);
+      for (int k = 0; k < 20; k++)
+        dm_integrator_step(Ic, h, qr, pr, qr, pr, NULL);
+      dm_integrator_reset(Ic);
+      for (int k = 0; k < 120; k++)
+        dm_integrator_step(Ic, h, qs, ps, qs, ps, NULL);
+      tap_ok(memcmp(qr, qs, sizeof qr) == 0 && memcmp(pr, ps, sizeof pr) == 0 &&
+             Ic->stats.steps == 120, "%s mass: composition order %d, run in chunks of 7 + 20 "
+             "steps = 120 single steps (bitwise)", names[c], oc.order);
+      dm_integrator_free(Ic);
+    }
     /* velocities of a separable system: v = M^{-1} p, whatever the guess,
      * with the mass of the moment (the system's parameters may change it) */
     {
@@ -532,6 +558,59 @@ static void test_verlet_mass(void)
   }
 }
 
+/* A composition whose force fails in the middle of a step: the run stops
+ * there and keeps the state after the last whole step. */
+typedef struct failing {
+  harm H;
+  long calls, fail_at;
+} failing;
+
+static int failing_lag(void *data, const double *q, const double *v, const double *par,
+                       unsigned what, dm_lag_out *o, void *work)
+{
+  failing *F = data;
+  if (++F->calls == F->fail_at)
+    return 1;
+  return harm_lag(&F->H, q, v, par, what, o, work);
+}
+
+static void test_comp_failure(void)
+{
+  failing F = {{{2.385, 0.3, 0.3, 1.2}, {2.385, 0.4, 0.4, 1.1}}, 0, 0};
+  const double q0[2] = {0.7, -0.3}, p0[2] = {0.2, 0.9}, h = 0.05;
+  double q[2], p[2], qs[2], ps[2];
+  dm_system sys;
+  dm_integ_opts o;
+  dm_integrator *I = NULL;
+  dm_run_info info;
+  dm_err e;
+  int st;
+  memset(&sys, 0, sizeof sys);
+  sys.name = "harmonic 2-dof, failing";
+  sys.n = 2;
+  sys.flags = DM_SYS_SEPARABLE | DM_SYS_MECHANICAL;
+  sys.mass = F.H.M;
+  sys.lagrangian = failing_lag;
+  sys.data = &F;
+  dm_integ_opts_init(&o);
+  o.order = 4;
+  dm_integrator_new(&sys, "composition", &o, &I, NULL);
+  memcpy(q, q0, sizeof q);
+  memcpy(p, p0, sizeof p);
+  F.fail_at = 1 + 10 * 3 + 2;       /* the initial force, 10 steps, 2 substeps into step 11 */
+  st = dm_integrator_run(I, 0.0, q, p, h, 50, 50, NULL, NULL, &info, &e);
+  dm_integrator_reset(I);
+  F.fail_at = 0;
+  memcpy(qs, q0, sizeof qs);
+  memcpy(ps, p0, sizeof ps);
+  for (int k = 0; k < 10; k++)
+    dm_integrator_step(I, h, qs, ps, qs, ps, NULL);
+  tap_ok(st == DM_EDOM && info.steps == 10 && memcmp(q, qs, sizeof q) == 0 &&
+         memcmp(p, ps, sizeof p) == 0, "composition: a force failing inside step 11 stops the "
+         "run after 10 steps, with their state (status %d, %ld steps)", st, info.steps);
+  dm_integrator_free(I);
+}
+
 /* }======================================================================= */
 
 int main(void)
@@ -546,5 +625,6 @@ int main(void)
   test_traced();
   test_reduced();
   test_verlet_mass();
+  test_comp_failure();
   return tap_done();
 }

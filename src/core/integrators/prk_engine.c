@@ -681,7 +681,7 @@ int dm_prk_type_advance(dm_integrator *I, double h, long nsteps, double *q, doub
   long k;
   int st = DM_OK;
   if (P->explicit_sv && P->m == 0)
-    return dm_prk_verlet_advance(P, h, nsteps, q, p, done, &I->stats, e);
+    return dm_prk_verlet_advance(P, h, NULL, 1, nsteps, q, p, done, &I->stats, e);
   for (k = 0; k < nsteps; k++) {
     if (dm_interrupted()) {
       st = DM_EINTR;

@@ -75,7 +75,8 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
 int dm_prk_verlet_setup(dm_prk *P, dm_err *e);
 int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
                        int cont, double *q1, double *p1, dm_integ_stats *st, dm_err *e);
-int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p, long *done,
-                          dm_integ_stats *st, dm_err *e);
+/* nsteps steps of ns substeps g[j] h each (g = NULL: plain Stormer-Verlet) */
+int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long nsteps,
+                          double *q, double *p, long *done, dm_integ_stats *st, dm_err *e);
 
 #endif

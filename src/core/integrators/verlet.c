@@ -247,34 +247,48 @@ static void drift(const dm_prk *P, double h, const double *q, const double *p, c
                    u + i);
 }
 
-/* The run loop's fast path for unconstrained Stormer-Verlet: nsteps steps
- * in place, one force evaluation per step (first same as last), Kahan
- * compensated updates.  The kick of step k and the drift of step k + 1
- * run in one pass (the drift's position goes to a buffer and becomes the
- * state when step k + 1 succeeds), so the new momenta flow to the next
- * positions in registers: the dependency chain of a step holds the force
- * and a few additions, not loads of values just stored.  Same arithmetic
- * as dm_prk_verlet_step, so results are bitwise identical to stepping. */
-int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p, long *done,
-                          dm_integ_stats *stt, dm_err *e)
+/* The run loop's fast path for unconstrained Stormer-Verlet, and for
+ * compositions of it: nsteps steps in place, each of ns substeps of
+ * g[j] h (g = NULL: one substep of h), one force evaluation per substep
+ * (first same as last), Kahan compensated updates whose carries run on
+ * across substeps and steps.  The kick of one substep and the drift of
+ * the next run in one pass (the drift's position goes to a buffer and
+ * becomes the state when the substep succeeds), so the new momenta flow to
+ * the next positions in registers: the dependency chain of a substep holds
+ * the force and a few additions, not loads of values just stored.  Same
+ * arithmetic as dm_prk_verlet_step called substep by substep, so results
+ * are bitwise identical to stepping (and to a composition's step()).
+ * q, p are written at step boundaries only: after a failure they hold the
+ * state after *done steps. */
+int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long nsteps,
+                          double *q, double *p, long *done, dm_integ_stats *stt, dm_err *e)
 {
+  static const double one = 1.0;
   const dm_system *sys = P->sys;
   const size_t n = P->n;
   const int kind = P->mass_kind;
-  const double hh = 0.5 * h, *Mi = P->Minv;
+  const double *Mi = P->Minv;
   double *f0 = P->Lq, *f1 = P->Lq + n, *tmp;
-  /* speculative positions of the next step, and the position carries and
-   * drift velocities of the state (c), of the next step (s) and of the one
-   * after (t), rotated as steps complete */
+  /* speculative positions of the next substep, and the position carries
+   * and drift velocities of the state (c), of the next substep (s) and of
+   * the one after (t), rotated as substeps complete; qw, pw: the state
+   * between substeps (the caller's arrays when there is one substep) */
   double *qs = P->q1w, *qt = P->tmp, *pn = P->dp, *ph = P->Q + n;
   double *cqc = P->cq, *cqs = P->dq, *cqt = P->p1w;
   double *uc = P->W, *us = P->W + n, *ut = P->Q;
-  double *cp = P->cp;
+  double *cp = P->cp, *qw, *pw;
+  double hk, hh;
   dm_lag_out o = {0, NULL, P->Lv + n, NULL, NULL, NULL};
-  long k;
-  size_t i;
+  long k = 0;
+  size_t i, j = 0;
   int st = DM_OK, rc;
   int cont = P->hist && dm_same(q, P->hq1, n) && dm_same(p, P->hp1, n);
+  if (g == NULL || ns == 0) {
+    g = &one;
+    ns = 1;
+  }
+  qw = ns == 1 ? q : P->R;
+  pw = ns == 1 ? p : P->R + n;
   *done = 0;
   if (!cont) {
     memset(P->cq, 0, n * sizeof(double));
@@ -288,13 +302,21 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
   P->hist = 0;
   P->svf_valid = 0;
   memset(P->v1w, 0, n * sizeof(double));
-  dm_vcopy(uc, P->X, n);           /* the last step's velocity, if any */
+  dm_vcopy(uc, P->X, n);           /* the last substep's velocity, if any */
+  if (qw != q) {
+    dm_vcopy(qw, q, n);
+    dm_vcopy(pw, p, n);
+  }
+  hk = g[0] * h;
+  hh = 0.5 * hk;
   if (nsteps > 0)
-    drift(P, h, q, p, f0, cqc, qs, cqs, us, ph);
-  for (k = 0; k < nsteps; k++) {
-    const int more = k + 1 < nsteps;
+    drift(P, hk, qw, pw, f0, cqc, qs, cqs, us, ph);
+  while (k < nsteps) {
+    const size_t jn = j + 1 == ns ? 0 : j + 1;
+    const int more = jn != 0 || k + 1 < nsteps;
+    const double hk1 = g[jn] * h, hh1 = 0.5 * hk1;
     int bad = 0;
-    if (dm_interrupted()) {
+    if (j == 0 && dm_interrupted()) {
       st = DM_EINTR;
       break;
     }
@@ -306,37 +328,47 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
       break;
     }
     /* kick: p1 = p + h/2 (f0 + f1), compensated, one finiteness test per
-     * step; then (unless this is the last step) the next drift from p1 */
+     * substep; then (unless this is the last) the next drift from p1 */
     if (kind != DM_MASS_FULL && more) {
       for (i = 0; i < n; i++) {
-        double f = f1[i], y = hh * (f0[i] + f) - cp[i], t = p[i] + y, qi = qs[i];
+        double f = f1[i], y = hh * (f0[i] + f) - cp[i], t = pw[i] + y, qi = qs[i];
         bad |= !isfinite(t) | !isfinite(qi);
-        cp[i] = (t - p[i]) - y;
+        cp[i] = (t - pw[i]) - y;
         pn[i] = t;
-        qt[i] = drift1(kind, Mi[i * n + i], h, t + hh * f, qi, cqs[i], cqt + i, ut + i);
+        qt[i] = drift1(kind, Mi[i * n + i], hk1, t + hh1 * f, qi, cqs[i], cqt + i, ut + i);
       }
     } else {
       for (i = 0; i < n; i++) {
-        double y = hh * (f0[i] + f1[i]) - cp[i], t = p[i] + y;
+        double y = hh * (f0[i] + f1[i]) - cp[i], t = pw[i] + y;
         bad |= !isfinite(t) | !isfinite(qs[i]);
-        cp[i] = (t - p[i]) - y;
+        cp[i] = (t - pw[i]) - y;
         pn[i] = t;
       }
       if (more)
-        drift(P, h, qs, pn, f1, cqs, qt, cqt, ut, ph);
+        drift(P, hk1, qs, pn, f1, cqs, qt, cqt, ut, ph);
     }
     if (bad) {
       st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
       break;
     }
     for (i = 0; i < n; i++) {
-      q[i] = qs[i];
-      p[i] = pn[i];
+      qw[i] = qs[i];
+      pw[i] = pn[i];
     }
     tmp = f0, f0 = f1, f1 = tmp;
     tmp = qs, qs = qt, qt = tmp;
     tmp = cqc, cqc = cqs, cqs = cqt, cqt = tmp;
     tmp = uc, uc = us, us = ut, ut = tmp;
+    hk = hk1;
+    hh = hh1;
+    j = jn;
+    if (j == 0) {
+      k++;
+      if (qw != q) {
+        dm_vcopy(q, qw, n);
+        dm_vcopy(p, pw, n);
+      }
+    }
   }
   *done = k;
   if (stt) {
@@ -346,7 +378,7 @@ int dm_prk_verlet_advance(dm_prk *P, double h, long nsteps, double *q, double *p
   }
   if (st == DM_OK || st == DM_EINTR) {
     /* history for the next call: continuation, carries, FSAL force, the
-     * last step's stage velocities */
+     * last substep's stage velocities */
     if (cqc != P->cq)
       dm_vcopy(P->cq, cqc, n);
     dm_vcopy(P->hq1, q, n);
