@@ -55,7 +55,8 @@ int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
 static int force_at(dm_prk *P, const double *q, double *f, dm_err *e)
 {
   dm_lag_out o = {0, f, P->Lv + P->n, NULL, NULL, NULL};
-  memset(P->v1w, 0, P->n * sizeof(double));   /* Lq of a separable L ignores v */
+  for (size_t i = 0; i < P->n; i++)
+    P->v1w[i] = 0.0;                         /* Lq of a separable L ignores v */
   return dm_eval_lag(P->sys, q, P->v1w, DM_LAG_Q, &o, P->work, e);
 }
 
@@ -153,22 +154,43 @@ int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
 {
   size_t n = P->n, m = P->m, a, c;
   double *f0 = P->Lq, *f1 = P->Lq + n, *u = P->X, *ph = P->dp;
+  const double hh = 0.5 * h;
   int st;
   if (cont && P->svf_valid)
-    memcpy(f0, P->svf, n * sizeof(double));
+    dm_vcopy(f0, P->svf, n);
   else if ((st = force_at(P, q0, f0, e)) != DM_OK)
     return st;
   P->svf_valid = 0;
   if (m == 0) {
-    for (c = 0; c < n; c++)
-      ph[c] = p0[c] + 0.5 * h * f0[c];
-    minv_mul(P, ph, u);
+    /* drift, force, kick: the arithmetic of the run loop (and of the
+     * constrained path below with mu = 0), inline */
+    double *cq = P->cq, *cp = P->cp;
     if (stt) {
       stt->iters = 0;
       stt->residual = 0.0;
       stt->tol = P->tol;
     }
-  } else {
+    for (c = 0; c < n; c++)
+      ph[c] = p0[c] + hh * f0[c];
+    minv_mul(P, ph, u);
+    for (c = 0; c < n; c++) {
+      double y = h * u[c] - cq[c], t = q0[c] + y;
+      cq[c] = (t - q0[c]) - y;
+      q1[c] = t;
+      P->X[n + c] = u[c];
+    }
+    if ((st = force_at(P, q1, f1, e)) != DM_OK)
+      return st;
+    for (c = 0; c < n; c++) {
+      double y = hh * (f0[c] + f1[c]) - cp[c], t = p0[c] + y;
+      cp[c] = (t - p0[c]) - y;
+      p1[c] = t;
+      P->svf[c] = f1[c];
+    }
+    P->svf_valid = 1;
+    return DM_OK;
+  }
+  {
     double *base = P->W, *G0 = P->G + P->s * m * n;
     if ((st = dm_prk_constr_begin(P, q0, e)) != DM_OK)
       return st;
@@ -191,23 +213,21 @@ int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
   /* dp accumulated in W + n.. as the increment p1 - p0 */
   {
     double *dp = P->W + n, *pp = P->Q, *pp0 = P->Q + n;
+    double *G0 = P->G + P->s * m * n, *G1 = P->G + (P->s + 1) * m * n, *mu0 = P->X + 2 * n;
     for (c = 0; c < n; c++)
       dp[c] = 0.5 * h * (f0[c] + f1[c]);
-    if (m > 0) {
-      double *G0 = P->G + P->s * m * n, *G1 = P->G + (P->s + 1) * m * n, *mu0 = P->X + 2 * n;
-      for (c = 0; c < n; c++)
-        for (a = 0; a < m; a++)
-          dp[c] -= G0[a * n + c] * mu0[a];
-      if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, P->g + (P->s + 1) * m, G1,
-                               NULL, P->work, e)) != DM_OK)
-        return st;
-      for (c = 0; c < n; c++)
-        pp[c] = pp0[c] = p0[c] + dp[c];
-      if ((st = dm_prk_project_momentum(P, q1, G1, pp, u, e)) != DM_OK)
-        return st;
-      for (c = 0; c < n; c++)
-        dp[c] += pp[c] - pp0[c];
-    }
+    for (c = 0; c < n; c++)
+      for (a = 0; a < m; a++)
+        dp[c] -= G0[a * n + c] * mu0[a];
+    if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, P->g + (P->s + 1) * m, G1,
+                             NULL, P->work, e)) != DM_OK)
+      return st;
+    for (c = 0; c < n; c++)
+      pp[c] = pp0[c] = p0[c] + dp[c];
+    if ((st = dm_prk_project_momentum(P, q1, G1, pp, u, e)) != DM_OK)
+      return st;
+    for (c = 0; c < n; c++)
+      dp[c] += pp[c] - pp0[c];
     dm_prk_kahan(n, p0, dp, P->cp, p1);
   }
   P->svf_valid = 1;
