@@ -484,9 +484,11 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
   return DM_OK;
 }
 
-/* For every request mask, the bundle that covers it at the least cost
- * (tape instructions, plus the outputs copied when it has more arrays
- * than asked for). */
+/* For every request mask, the bundle that covers it at the least cost:
+ * tape instructions, plus the outputs copied when it has more arrays than
+ * asked for, four times that when the bundle runs on the tape (native
+ * code, where it compiled, always wins over a tape; with auto a bundle
+ * whose compilation failed falls back to its tape alone). */
 static void select_progs(lag_data *d)
 {
   const prog *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
@@ -498,6 +500,8 @@ static void select_progs(lag_data *d)
       if (p->tape == NULL || (w & ~p->have) != 0)
         continue;
       size_t c = dm_tape_ninstr(p->tape) + ((p->have & ~(w | DM_LAG_L)) ? p->nout : 0);
+      if (p->scatter == NULL)
+        c = 4 * c + 4;
       if (c < bc) {
         bc = c;
         best = p;
