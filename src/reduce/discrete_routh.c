@@ -212,9 +212,10 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
   const dm_routh *red = dr->red;
   const double *mu = red->par + red->npar;
   size_t n = dr->n, r = dr->r, d = dr->d, a, b, i, it;
-  double Jr[DM_ROUTH_RMAX * DM_ROUTH_RMAX], f[DM_ROUTH_RMAX], dn = HUGE_VAL, best = HUGE_VAL;
+  double Jr[DM_ROUTH_RMAX * DM_ROUTH_RMAX], f[DM_ROUTH_RMAX], dn = HUGE_VAL;
   double xb[64], *xbar = d <= 64 ? xb : dr->dx;
-  int st, ok = 0, stall = 0;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int st, ok = 0;
   for (i = 0; i < d; i++)
     xbar[i] = 0.5 * (x0[i] + x1[i]);
   if ((st = conn_at(dr, xbar, 0, e)) != DM_OK)
@@ -246,15 +247,7 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
     for (a = 0; a < r; a++)
       dr->psi[a] -= f[a];
     dn = dm_rnorm_inf(f, r) / fmax(dm_rnorm_inf(dr->psi, r), fabs(h) * DBL_MIN + 1e-300);
-    if (dn <= dr->tol || dm_rnorm_inf(f, r) == 0.0) {
-      ok = 1;
-      break;
-    }
-    if (dn <= 1e-10 && dn > 0.5 * best)
-      stall++;
-    if (dn < best)
-      best = dn;
-    if (stall >= 2) {
+    if (dm_rnorm_inf(f, r) == 0.0 || dm_newton_done(&stop, dn, dr->tol)) {
       ok = 1;
       break;
     }
@@ -370,8 +363,9 @@ int dm_routh_dr_step(dm_routh_dr *dr, double h, const double *x0, const double *
 {
   const dm_routh *red = dr->red;
   size_t n = dr->n, r = dr->r, d = dr->d, i, k, a, it;
-  double dn = HUGE_VAL, best = HUGE_VAL, *D1 = dr->res, *A1 = dr->dx;
-  int st, ok = 0, stall = 0;
+  double dn = HUGE_VAL, *D1 = dr->res, *A1 = dr->dx;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int st, ok = 0;
   st = dm_routh_check_inertia(red, x0, &dr->sing_ref, dr->twork, "the initial point", e);
   if (st != DM_OK)
     return st;
@@ -421,15 +415,7 @@ int dm_routh_dr_step(dm_routh_dr *dr, double h, const double *x0, const double *
       st = dm_err_set(e, DM_EDOM, "discrete Routh equations: non-finite Newton update (h = %g)", h);
       break;
     }
-    if (dn <= dr->tol) {
-      ok = 1;
-      break;
-    }
-    if (dn <= 1e-10 && dn > 0.5 * best)
-      stall++;
-    if (dn < best)
-      best = dn;
-    if (stall >= 2) {
+    if (dm_newton_done(&stop, dn, dr->tol)) {
       ok = 1;
       break;
     }

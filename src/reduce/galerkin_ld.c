@@ -149,8 +149,9 @@ int dm_gld_solve(dm_gld *g, double h, const double *q0, const double *q1, double
 {
   size_t n = g->n, S = g->S, Sn = g->Sn, N = g->N, nn = g->nn, i, j, k, a, c, x;
   const double *A = g->tab->a, *At = g->tab->at, *b = g->tab->b;
-  double dn = HUGE_VAL, best = HUGE_VAL;
-  int it, st, stall = 0, ok = 0;
+  double dn = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st, ok = 0;
   if (h == 0.0)
     return dm_err_set(e, DM_EINVAL, "discrete Lagrangian needs h != 0");
   if (!(warm && g->warm_ok))
@@ -176,15 +177,7 @@ int dm_gld_solve(dm_gld *g, double h, const double *q0, const double *q1, double
     dn = fmax(dm_rnorm_inf(g->R, Sn) / vs, dm_rnorm_inf(g->R + Sn, n) / ps);
     if (!isfinite(dn))
       break;
-    if (dn <= g->tol) {
-      ok = 1;
-      break;
-    }
-    if (dn <= 1e-10 && dn > 0.5 * best)
-      stall++;
-    if (dn < best)
-      best = dn;
-    if (stall >= 2) {
+    if (dm_newton_done(&stop, dn, g->tol)) {
       ok = 1;
       break;
     }

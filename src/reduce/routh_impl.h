@@ -4,6 +4,7 @@
 #define DM_ROUTH_IMPL_H
 
 #include "routh.h"
+#include "core/newton.h"
 #include "core/tape.h"
 
 /* A compiled bundle of outputs: tape, and native code when available. */

@@ -13,9 +13,9 @@
  * Newton uses the exact Jacobian
  *   dr_i/dXd_k = d_ik Rvv_i + h a_ik (Rvx_i + K_i) - h at_ik E_k - h^2 sum_j at_ij a_jk D_j,
  *   E_k = Rxv_k - B_k^T + Fv_k + K_k,  D_j = Rxx_j - d(i beta)/dx_j + Fx_j + d(K Xd)/dx_j,
- * with the engine's stopping rules (prk_engine.c: scaled update <= tol, or
- * round-off stall once below 1e-10; simplified Newton reusing the factored
- * exact Jacobian while updates contract tenfold).  The group increment of
+ * with the engine's stopping rule (src/core/newton.h: scaled update <= tol,
+ * or round-off stall once below 1e-10) and, as prk_engine.c, simplified
+ * Newton reusing the factored exact Jacobian while updates contract tenfold.  The group increment of
  * the step (Hamiltonian-side reconstruction) is h sum_j b_j Thetadot_j,
  * Thetadot_j = I(X_j)^{-1} mu - A(X_j) Xd_j.  The step Jacobian comes from
  * the implicit function theorem on the converged stage equations. */
@@ -28,8 +28,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define NEWTON_ACCEPT 1e-10
 
 const dm_tableau *dm_rsprk_tableau(const dm_rsprk *P)
 {
@@ -470,8 +468,9 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
                   dm_err *e)
 {
   size_t N = P->N, i;
-  double dn = HUGE_VAL, dbest = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
-  int it, st, stall = 0, ok = 0, jac = 1, njac = 0;
+  double dn = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st, ok = 0, jac = 1, njac = 0;
   for (it = 1; it <= P->maxiter; it++) {
     if ((st = assemble(P, h, x0, s0, jac, e)) != DM_OK)
       return explain(P, st, e);
@@ -508,15 +507,7 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
     }
     if (!isfinite(dn))
       return explain(P, dm_err_set(e, DM_EDOM, "RSPRK: non-finite Newton update (h = %g)", h), e);
-    if (dn <= P->tol) {
-      ok = 1;
-      break;
-    }
-    if (dn <= NEWTON_ACCEPT && dn > 0.5 * dbest)
-      stall++;
-    if (dn < dbest)
-      dbest = dn;
-    if (stall >= 2) {
+    if (dm_newton_done(&stop, dn, P->tol)) {
       ok = 1;
       break;
     }

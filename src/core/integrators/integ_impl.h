@@ -2,7 +2,8 @@
  * (not part of the public API; include only from src/core/integrators).
  *
  *  - checked callback evaluation (SUNDIALS statuses -> DM_* with messages),
- *  - the infinity norm of the Newton tests (LU: src/core/smalllu.h),
+ *  - the infinity norm of the Newton tests (stopping rule: src/core/newton.h,
+ *    LU: src/core/smalllu.h),
  *  - the Legendre-map workspace (velocity Newton, Hamiltonian vector field
  *    and its Jacobian, used by rk4 and gsl:*),
  *  - the implicit PRK engine used by midpoint/gauss/trapezoid/lobatto/prk
@@ -19,22 +20,8 @@
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_permutation.h>
 #include "integrator.h"
+#include "newton.h"
 #include "smalllu.h"
-
-/* Newton iterations stop at the tolerance, or, once the scaled update is
- * below DM_NEWTON_ACCEPT, when two updates failed to halve the best update
- * so far (the round-off floor of an ill-conditioned system, where updates
- * bounce around 1e-14 instead of decreasing). */
-#define DM_NEWTON_ACCEPT 1e-10
-
-static inline int dm_newton_stalled(double d, double *best, int *stall)
-{
-  if (d <= DM_NEWTON_ACCEPT && d > 0.5 * *best)
-    (*stall)++;
-  if (d < *best)
-    *best = d;
-  return *stall >= 2;
-}
 
 /* {==== checked evaluation ============================================== */
 

@@ -136,8 +136,9 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
   size_t n = w->n, i;
   dm_lag_out o = {0, w->Lq, w->Lv, w->Lvv, w->Lvq, w->Lqq};
   int mech = (w->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
-  double dprev = HUGE_VAL, d = HUGE_VAL;
-  int it, st, stall = 0;
+  double d = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st;
   if ((w->sys->flags & DM_SYS_SEPARABLE) && w->sys->mass != NULL)
     return separable_velocity(w, p, v, e);
   if (!guess)
@@ -162,9 +163,7 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
     d = dm_norm_inf(w->r, n) / (vs > 0 ? vs : 1.0);
     if (!isfinite(d))
       return dm_err_set(e, DM_EDOM, "velocity solve produced a non-finite value");
-    if (mech || d <= w->tol)
-      return DM_OK;
-    if (dm_newton_stalled(d, &dprev, &stall))
+    if (mech || dm_newton_done(&stop, d, w->tol))
       return DM_OK;
   }
   return dm_err_set(e, DM_ENOCONV,

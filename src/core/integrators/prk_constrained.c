@@ -185,8 +185,9 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
   double *y = P->rhs, *v = P->rhs, *mu = P->rhs + n;
   dm_lag_out o = {0, P->Lq, P->Lv, P->Lvv, P->Lvq, P->Lqq};   /* stage-1 buffers as scratch */
   int mech = (P->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
-  double d = HUGE_VAL, dprev = HUGE_VAL;
-  int it, st, stall = 0;
+  double d = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st;
   memcpy(v, vguess, n * sizeof(double));
   memset(mu, 0, m * sizeof(double));
   for (it = 0; it < P->maxiter; it++) {
@@ -224,9 +225,7 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
     vs = fmax(fmax(dm_norm_inf(v, n), ls > 0 ? ps / ls : 0.0), DBL_MIN);
     d = fmax(dm_norm_inf(P->R, n) / vs,
              dm_norm_inf(P->R + n, m) / fmax(fmax(dm_norm_inf(mu, m), ps), DBL_MIN));
-    if (mech || d <= P->tol)
-      break;
-    if (dm_newton_stalled(d, &dprev, &stall))
+    if (mech || dm_newton_done(&stop, d, P->tol))
       break;
   }
   if (it == P->maxiter)

@@ -11,10 +11,9 @@
  * factored with GSL LU (by default as a simplified Newton: the Jacobian
  * factored at the first iterate is reused while the updates contract at
  * least tenfold, and refreshed otherwise; option simplified = false
- * refactors every iteration), and iterates to round-off: stop when the scaled
- * update is <= tol (default 10 eps), or, once the update is below
- * DM_NEWTON_ACCEPT = 1e-10 (round-off regime of an ill-conditioned system),
- * after two updates that did not halve the best one; at most maxiter
+ * refactors every iteration), and iterates to round-off with the stopping
+ * rule of src/core/newton.h (scaled update <= tol, default 10 eps, or a
+ * round-off stall below DM_NEWTON_ACCEPT = 1e-10); at most maxiter
  * iterations (failure: DM_ENOCONV with the update, residual and tolerance).
  * The predictor extrapolates the previous step's stage-velocity polynomial
  * (nodes c, values V) to the new stage times; without history (or with
@@ -347,8 +346,9 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
                   const double *q1t, dm_integ_stats *stt, dm_err *e)
 {
   size_t N = nunk(P, mode), i;
-  double d = HUGE_VAL, dbest = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
-  int it, st, stall = 0, ok = 0, jac = 1, njac = 0;
+  double d = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st, ok = 0, jac = 1, njac = 0;
   for (it = 1; it <= P->maxiter; it++) {
     if ((st = assemble(P, mode, h, q0, p0, q1t, jac, e)) != DM_OK)
       return st;
@@ -385,12 +385,9 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
     }
     if (!isfinite(d))
       return dm_err_set(e, DM_EDOM, "non-finite Newton update (h = %g)", h);
-    if (d <= P->tol) {
-      ok = 1;
-      break;
-    }
-    /* in the round-off regime, stop once the updates stop contracting */
-    if (dm_newton_stalled(d, &dbest, &stall)) {
+    /* at the tolerance, or in the round-off regime once the updates stop
+     * contracting (newton.h) */
+    if (dm_newton_done(&stop, d, P->tol)) {
       ok = 1;
       break;
     }

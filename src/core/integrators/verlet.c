@@ -90,8 +90,9 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
 {
   size_t n = P->n, m = P->m, a, b, c;
   double *u = P->X, *mu = P->X + 2 * n, *qq = P->tmp, *gq = P->g, *Gq = P->G, *ph = P->dp;
-  double d = HUGE_VAL, dprev = HUGE_VAL;
-  int it, st, stall = 0;
+  double d = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st;
   for (it = 1; it <= P->maxiter; it++) {
     for (c = 0; c < n; c++) {
       double acc = base[c];
@@ -125,9 +126,7 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
     for (a = 0; a < m; a++)
       mu[a] -= P->R[a];
     d = dm_norm_inf(P->R, m) / fmax(fmax(dm_norm_inf(mu, m), ms), DBL_MIN);
-    if (d <= P->tol)
-      break;
-    if (dm_newton_stalled(d, &dprev, &stall))
+    if (dm_newton_done(&stop, d, P->tol))
       break;
   }
   if (stt) {
