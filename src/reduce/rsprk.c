@@ -21,6 +21,7 @@
  * the implicit function theorem on the converged stage equations. */
 #include <config.h>
 #include "rsprk_impl.h"
+#include "core/integrators/prk_kernels.h"
 #include "core/interrupt.h"
 
 #include <float.h>
@@ -534,16 +535,6 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
 
 /* {==== predictor ======================================================== */
 
-static double lagrange_basis(size_t s, const double *c, size_t j, double x)
-{
-  double v = 1.0;
-  size_t k;
-  for (k = 0; k < s; k++)
-    if (k != j)
-      v *= (x - c[k]) / (c[j] - c[k]);
-  return v;
-}
-
 int dm_rsprk_velocity(dm_rsprk *P, const double *x, const double *s, double *v, dm_err *e)
 {
   size_t d = P->d, dd = P->dd;
@@ -585,22 +576,9 @@ int dm_rsprk_velocity(dm_rsprk *P, const double *x, const double *s, double *v, 
 
 static int predict(dm_rsprk *P, double h, const double *x0, const double *s0, int cont, dm_err *e)
 {
-  size_t d = P->d, S = P->S, Sd = P->Sd, N = P->N, i, j, a;
+  size_t d = P->d, S = P->S, Sd = P->Sd, N = P->N, i;
   if (cont && P->distinct_nodes) {
-    double rr = h / P->hist_h;
-    if (rr != P->E_ratio) {
-      for (i = 0; i < S; i++)
-        for (j = 0; j < S; j++)
-          P->Ex[i * S + j] = lagrange_basis(S, P->tab->c, j, 1.0 + rr * P->tab->c[i]);
-      P->E_ratio = rr;
-    }
-    for (i = 0; i < S; i++)
-      for (a = 0; a < d; a++) {
-        double acc = 0.0;
-        for (j = 0; j < S; j++)
-          acc += P->Ex[i * S + j] * P->hV[j * d + a];
-        P->X[i * d + a] = acc;
-      }
+    dm_prk_extrapolate(S, d, P->tab->c, h / P->hist_h, P->Ex, &P->E_ratio, P->hV, P->X);
   } else if (cont) {
     memcpy(P->X, P->hV, Sd * sizeof(double));
   } else {

@@ -33,6 +33,7 @@
  */
 #include <config.h>
 #include "prk_impl.h"
+#include "prk_kernels.h"
 #include "interrupt.h"
 
 #include <float.h>
@@ -418,35 +419,12 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
   return assemble(P, mode, h, q0, p0, q1t, 0, e);
 }
 
-static double lagrange_d(size_t s, const double *c, size_t j, double x)
-{
-  double v = 1.0;
-  size_t k;
-  for (k = 0; k < s; k++)
-    if (k != j)
-      v *= (x - c[k]) / (c[j] - c[k]);
-  return v;
-}
-
 static int predict(dm_prk *P, double h, const double *q0, const double *p0, int cont,
                    dm_err *e)
 {
-  size_t n = P->n, s = P->s, sn = P->sn, i, j, a, N = nunk(P, P->m ? DM_PRK_CSTEP : DM_PRK_STEP);
+  size_t n = P->n, s = P->s, sn = P->sn, i, N = nunk(P, P->m ? DM_PRK_CSTEP : DM_PRK_STEP);
   if (cont && P->distinct_nodes) {
-    double r = h / P->hist_h;
-    if (r != P->E_ratio) {
-      for (i = 0; i < s; i++)
-        for (j = 0; j < s; j++)
-          P->E[i * s + j] = lagrange_d(s, P->tab->c, j, 1.0 + r * P->tab->c[i]);
-      P->E_ratio = r;
-    }
-    for (i = 0; i < s; i++)
-      for (a = 0; a < n; a++) {
-        double acc = 0.0;
-        for (j = 0; j < s; j++)
-          acc += P->E[i * s + j] * P->hV[j * n + a];
-        P->X[i * n + a] = acc;
-      }
+    dm_prk_extrapolate(s, n, P->tab->c, h / P->hist_h, P->E, &P->E_ratio, P->hV, P->X);
   } else if (cont) {
     memcpy(P->X, P->hV, sn * sizeof(double));
   } else {
