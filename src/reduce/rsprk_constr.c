@@ -1,6 +1,7 @@
 /* rsprk_constr.c -- holonomic constraints ghat(y) = 0 on the preshape space
  * in the RSPRK step (thesis §2.8, Theorems 2.14 / 2.17; spec routh.md §6),
- * with the multiplier layout of src/core/integrators/prk_constrained.c:
+ * with the multiplier layout of src/core/integrators/prk_constrained.c and
+ * its kernels (prk_kernels.h: stages, residual/Jacobian terms, impulses):
  * unknowns (Xd_i, Lt_k for the interior stages k of a Lobatto-type tableau,
  * mu0 on the initial momentum); equations
  *   r_i + G(x0)^T mu0 + sum_k at_ik G(X_k)^T Lt_k = 0,
@@ -12,36 +13,16 @@
  * term muA(x1) is fixed), so the reduction commutes with RATTLE. */
 #include <config.h>
 #include "rsprk_impl.h"
+#include "core/integrators/prk_kernels.h"
 
 #include <math.h>
 #include <string.h>
 
-static int lobatto_type(const dm_tableau *t)
-{
-  size_t s = t->s, i;
-  if (s < 2 || t->c[0] != 0.0 || t->c[s - 1] != 1.0)
-    return 0;
-  for (i = 0; i < s; i++)
-    if (t->a[i] != 0.0 || fabs(t->a[(s - 1) * s + i] - t->b[i]) > 1e-14
-        || t->at[i * s + s - 1] != 0.0 || fabs(t->at[i * s] - t->b[0]) > 1e-14)
-      return 0;
-  return 1;
-}
-
 int dm_rsprk_constr_layout(dm_rsprk *P, dm_err *e)
 {
   const dm_tableau *t = P->tab;
-  size_t k;
-  if (t->s == 1) {
-    P->nK = 0;
+  if (dm_prk_constr_stages(t, &P->nK, P->K))
     return DM_OK;
-  }
-  if (lobatto_type(t)) {
-    P->nK = t->s - 2;
-    for (k = 0; k < P->nK; k++)
-      P->K[k] = k + 1;
-    return DM_OK;
-  }
   return dm_err_set(e, DM_EUNSUP, "constraints on the preshape space are not supported with the "
                     "%s tableau (s = %zu): use 'lobatto' (multipliers at every stage), 'trapezoid' "
                     "or 'midpoint'", t->name, t->s);
@@ -71,14 +52,15 @@ int dm_rsprk_constr_begin(dm_rsprk *P, const double *x0, dm_err *e)
   return DM_OK;
 }
 
+/* The constraints at the constrained stages (with second derivatives when
+ * jac) and at x1 = x0 + h sum b_j Xd_j, then their terms in the residual and
+ * the Newton matrix (the core's dm_prk_constr_terms). */
 int dm_rsprk_constr_assemble(dm_rsprk *P, double h, const double *x0, int jac, dm_err *e)
 {
-  size_t d = P->d, S = P->S, m = P->m, dd = P->dd, Sd = P->Sd;
-  size_t N = P->N, offL = Sd, offM = Sd + P->nK * m;
-  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
-  const double *G0 = P->G + S * m * d, *mu0 = P->X + offM;
-  double *x1 = P->tmp, *g1 = P->g + (S + 1) * m, *G1 = P->G + (S + 1) * m * d;
-  size_t i, kk, l, a, c, y;
+  size_t d = P->d, S = P->S;
+  const double *b = P->tab->b;
+  double *x1 = P->tmp;
+  size_t kk, l, a;
   int st;
   for (kk = 0; kk < P->nK; kk++)
     if ((st = constr(P, P->Xs + P->K[kk] * d,
@@ -92,55 +74,8 @@ int dm_rsprk_constr_assemble(dm_rsprk *P, double h, const double *x0, int jac, d
   }
   if ((st = constr(P, x1, DM_CONSTR_G | DM_CONSTR_DG, S + 1, e)) != DM_OK)
     return st;
-  for (i = 0; i < S; i++)
-    for (c = 0; c < d; c++) {
-      double acc = 0.0;
-      for (a = 0; a < m; a++)
-        acc += G0[a * d + c] * mu0[a];
-      for (kk = 0; kk < P->nK; kk++) {
-        size_t k = P->K[kk];
-        const double *Gk = P->G + k * m * d, *Lk = P->X + offL + kk * m;
-        for (a = 0; a < m; a++)
-          acc += At[i * S + k] * Gk[a * d + c] * Lk[a];
-      }
-      P->R[i * d + c] += acc;
-    }
-  for (kk = 0; kk < P->nK; kk++)
-    for (a = 0; a < m; a++)
-      P->R[offL + kk * m + a] = P->g[P->K[kk] * m + a] / h;
-  for (a = 0; a < m; a++)
-    P->R[offM + a] = g1[a] / h;
-  if (!jac)
-    return DM_OK;
-  for (kk = 0; kk < P->nK; kk++) {
-    size_t k = P->K[kk];
-    const double *Gk = P->G + k * m * d, *Hk = P->Hc + k * m * dd, *Lk = P->X + offL + kk * m;
-    for (c = 0; c < d; c++)
-      for (y = 0; y < d; y++) {
-        double hs = 0.0;
-        for (a = 0; a < m; a++)
-          hs += Lk[a] * Hk[(a * d + c) * d + y];
-        for (i = 0; i < S; i++)
-          for (l = 0; l < S; l++)
-            P->Jm[(i * d + c) * N + l * d + y] += At[i * S + k] * h * A[k * S + l] * hs;
-      }
-    for (i = 0; i < S; i++)
-      for (c = 0; c < d; c++)
-        for (a = 0; a < m; a++)
-          P->Jm[(i * d + c) * N + offL + kk * m + a] = At[i * S + k] * Gk[a * d + c];
-    for (a = 0; a < m; a++)
-      for (l = 0; l < S; l++)
-        for (y = 0; y < d; y++)
-          P->Jm[(offL + kk * m + a) * N + l * d + y] = A[k * S + l] * Gk[a * d + y];
-  }
-  for (i = 0; i < S; i++)
-    for (c = 0; c < d; c++)
-      for (a = 0; a < m; a++)
-        P->Jm[(i * d + c) * N + offM + a] = G0[a * d + c];
-  for (a = 0; a < m; a++)
-    for (l = 0; l < S; l++)
-      for (y = 0; y < d; y++)
-        P->Jm[(offM + a) * N + l * d + y] = b[l] * G1[a * d + y];
+  dm_prk_constr_terms(P->tab, d, P->m, P->nK, P->K, h, P->X, P->g, P->G, P->Hc, P->R,
+                      jac ? P->Jm : NULL);
   return DM_OK;
 }
 
@@ -191,23 +126,12 @@ int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double
                            double *s1, dm_err *e)
 {
   const dm_routh *red = P->red;
-  size_t d = P->d, S = P->S, m = P->m, offL = P->Sd, offM = P->Sd + P->nK * m;
-  const double *b = P->tab->b, *G0 = P->G + S * m * d;
+  size_t d = P->d, S = P->S, m = P->m;
   double *G1 = P->G + (S + 1) * m * d, *pp = s1;   /* s1 is written last */
-  size_t kk, a, c;
+  size_t c;
   int st;
   (void)h;
-  for (c = 0; c < d; c++) {
-    double sp = P->dp[c];
-    for (a = 0; a < m; a++)
-      sp -= G0[a * d + c] * P->X[offM + a];
-    for (kk = 0; kk < P->nK; kk++) {
-      const double *Gk = P->G + P->K[kk] * m * d;
-      for (a = 0; a < m; a++)
-        sp -= b[P->K[kk]] * Gk[a * d + c] * P->X[offL + kk * m + a];
-    }
-    P->dp[c] = sp;
-  }
+  dm_prk_constr_momentum(P->tab, d, m, P->nK, P->K, P->X, P->G, P->dp);
   kahan(d, x0, P->dq, P->cq, x1);
   if (P->gyro) {
     double *o = P->tout;

@@ -40,6 +40,7 @@
  */
 #include <config.h>
 #include "prk_impl.h"
+#include "prk_kernels.h"
 
 #include <float.h>
 #include <math.h>
@@ -57,23 +58,29 @@ static int lobatto_type(const dm_tableau *t)
   return 1;
 }
 
+int dm_prk_constr_stages(const dm_tableau *t, size_t *nK, size_t *K)
+{
+  size_t k;
+  if (t->s == 1) {
+    *nK = 0;
+    return 1;
+  }
+  if (!lobatto_type(t))
+    return 0;
+  *nK = t->s - 2;
+  for (k = 0; k < *nK; k++)
+    K[k] = k + 1;
+  return 1;
+}
+
 int dm_prk_constr_layout(dm_prk *P, dm_err *e)
 {
   const dm_tableau *t = P->tab;
-  size_t k;
   if (P->sys->constraints == NULL)
     return dm_err_set(e, DM_EINVAL, "system '%s' declares m = %zu constraints but no constraint function",
                       P->sys->name ? P->sys->name : "?", P->m);
-  if (t->s == 1) {
-    P->nK = 0;
+  if (dm_prk_constr_stages(t, &P->nK, P->K))
     return DM_OK;
-  }
-  if (lobatto_type(t)) {
-    P->nK = t->s - 2;
-    for (k = 0; k < P->nK; k++)
-      P->K[k] = k + 1;
-    return DM_OK;
-  }
   return dm_err_set(e, DM_EUNSUP,
                     "holonomic constraints are not supported with the %s tableau (s = %zu): "
                     "a degree-s curve cannot keep all Gauss stage points and both end points on "
@@ -97,16 +104,97 @@ int dm_prk_constr_begin(dm_prk *P, const double *q0, dm_err *e)
   return DM_OK;
 }
 
+void dm_prk_constr_terms(const dm_tableau *t, size_t n, size_t m, size_t nK, const size_t *K,
+                         double h, const double *X, const double *g, const double *G,
+                         const double *Hc, double *R, double *Jm)
+{
+  const size_t s = t->s, nn = n * n, sn = s * n;
+  const size_t N = sn + nK * m + m, offL = sn, offM = sn + nK * m;
+  const double *A = t->a, *At = t->at, *b = t->b;
+  const double *G0 = G + s * m * n, *mu0 = X + offM;
+  const double *g1 = g + (s + 1) * m, *G1 = G + (s + 1) * m * n;
+  size_t i, kk, l, a, c, x;
+  /* residual: multiplier terms in the stage equations, constraint rows */
+  for (i = 0; i < s; i++)
+    for (c = 0; c < n; c++) {
+      double acc = 0.0;
+      for (a = 0; a < m; a++)
+        acc += G0[a * n + c] * mu0[a];
+      for (kk = 0; kk < nK; kk++) {
+        size_t k = K[kk];
+        const double *Gk = G + k * m * n, *Lk = X + offL + kk * m;
+        for (a = 0; a < m; a++)
+          acc += At[i * s + k] * Gk[a * n + c] * Lk[a];
+      }
+      R[i * n + c] += acc;
+    }
+  for (kk = 0; kk < nK; kk++)
+    for (a = 0; a < m; a++)
+      R[offL + kk * m + a] = g[K[kk] * m + a] / h;
+  for (a = 0; a < m; a++)
+    R[offM + a] = g1[a] / h;
+  if (Jm == NULL)
+    return;
+  for (kk = 0; kk < nK; kk++) {
+    size_t k = K[kk];
+    const double *Gk = G + k * m * n, *Hk = Hc + k * m * nn, *Lk = X + offL + kk * m;
+    /* curvature term: sum_a Lt_a d2g_a(Q_k) into blocks (i, l) */
+    for (c = 0; c < n; c++)
+      for (x = 0; x < n; x++) {
+        double hs = 0.0;
+        for (a = 0; a < m; a++)
+          hs += Lk[a] * Hk[(a * n + c) * n + x];
+        for (i = 0; i < s; i++)
+          for (l = 0; l < s; l++)
+            Jm[(i * n + c) * N + l * n + x] += At[i * s + k] * h * A[k * s + l] * hs;
+      }
+    for (i = 0; i < s; i++)
+      for (c = 0; c < n; c++)
+        for (a = 0; a < m; a++)
+          Jm[(i * n + c) * N + offL + kk * m + a] = At[i * s + k] * Gk[a * n + c];
+    for (a = 0; a < m; a++)
+      for (l = 0; l < s; l++)
+        for (x = 0; x < n; x++)
+          Jm[(offL + kk * m + a) * N + l * n + x] = A[k * s + l] * Gk[a * n + x];
+  }
+  for (i = 0; i < s; i++)
+    for (c = 0; c < n; c++)
+      for (a = 0; a < m; a++)
+        Jm[(i * n + c) * N + offM + a] = G0[a * n + c];
+  for (a = 0; a < m; a++)
+    for (l = 0; l < s; l++)
+      for (x = 0; x < n; x++)
+        Jm[(offM + a) * N + l * n + x] = b[l] * G1[a * n + x];
+}
+
+void dm_prk_constr_momentum(const dm_tableau *t, size_t n, size_t m, size_t nK, const size_t *K,
+                            const double *X, const double *G, double *dp)
+{
+  const size_t s = t->s, offL = s * n, offM = s * n + nK * m;
+  const double *b = t->b, *G0 = G + s * m * n;
+  size_t kk, a, c;
+  for (c = 0; c < n; c++) {
+    double sp = dp[c];
+    for (a = 0; a < m; a++)
+      sp -= G0[a * n + c] * X[offM + a];
+    for (kk = 0; kk < nK; kk++) {
+      const double *Gk = G + K[kk] * m * n;
+      for (a = 0; a < m; a++)
+        sp -= b[K[kk]] * Gk[a * n + c] * X[offL + kk * m + a];
+    }
+    dp[c] = sp;
+  }
+}
+
+/* The constraints at the constrained stages (with second derivatives when
+ * jac) and at q1 = q0 + h sum b_j V_j, then their terms (above). */
 int dm_prk_constr_assemble(dm_prk *P, double h, const double *q0, int jac, dm_err *e)
 {
-  size_t n = P->n, s = P->s, m = P->m, nn = P->nn, sn = P->sn;
-  size_t N = sn + P->nK * m + m, offL = sn, offM = sn + P->nK * m;
-  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
-  const double *G0 = P->G + s * m * n, *mu0 = P->X + offM;
+  size_t n = P->n, s = P->s, m = P->m, nn = P->nn;
+  const double *b = P->tab->b;
   double *q1 = P->tmp, *g1 = P->g + (s + 1) * m, *G1 = P->G + (s + 1) * m * n;
-  size_t i, kk, l, a, c, x;
+  size_t kk, l, a;
   int st;
-  /* constraint values at the constrained stages and at q1 */
   for (kk = 0; kk < P->nK; kk++) {
     size_t k = P->K[kk];
     st = dm_eval_constr(P->sys, P->Q + k * n, DM_CONSTR_G | DM_CONSTR_DG | (jac ? DM_CONSTR_D2G : 0u),
@@ -122,57 +210,8 @@ int dm_prk_constr_assemble(dm_prk *P, double h, const double *q0, int jac, dm_er
   }
   if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, g1, G1, NULL, P->work, e)) != DM_OK)
     return st;
-  /* residual: multiplier terms in the stage equations, constraint rows */
-  for (i = 0; i < s; i++)
-    for (c = 0; c < n; c++) {
-      double acc = 0.0;
-      for (a = 0; a < m; a++)
-        acc += G0[a * n + c] * mu0[a];
-      for (kk = 0; kk < P->nK; kk++) {
-        size_t k = P->K[kk];
-        const double *Gk = P->G + k * m * n, *Lk = P->X + offL + kk * m;
-        for (a = 0; a < m; a++)
-          acc += At[i * s + k] * Gk[a * n + c] * Lk[a];
-      }
-      P->R[i * n + c] += acc;
-    }
-  for (kk = 0; kk < P->nK; kk++)
-    for (a = 0; a < m; a++)
-      P->R[offL + kk * m + a] = P->g[P->K[kk] * m + a] / h;
-  for (a = 0; a < m; a++)
-    P->R[offM + a] = g1[a] / h;
-  if (!jac)
-    return DM_OK;
-  for (kk = 0; kk < P->nK; kk++) {
-    size_t k = P->K[kk];
-    const double *Gk = P->G + k * m * n, *Hk = P->Hc + k * m * nn, *Lk = P->X + offL + kk * m;
-    /* curvature term: sum_a Lt_a d2g_a(Q_k) into blocks (i, l) */
-    for (c = 0; c < n; c++)
-      for (x = 0; x < n; x++) {
-        double hs = 0.0;
-        for (a = 0; a < m; a++)
-          hs += Lk[a] * Hk[(a * n + c) * n + x];
-        for (i = 0; i < s; i++)
-          for (l = 0; l < s; l++)
-            P->Jm[(i * n + c) * N + l * n + x] += At[i * s + k] * h * A[k * s + l] * hs;
-      }
-    for (i = 0; i < s; i++)
-      for (c = 0; c < n; c++)
-        for (a = 0; a < m; a++)
-          P->Jm[(i * n + c) * N + offL + kk * m + a] = At[i * s + k] * Gk[a * n + c];
-    for (a = 0; a < m; a++)
-      for (l = 0; l < s; l++)
-        for (x = 0; x < n; x++)
-          P->Jm[(offL + kk * m + a) * N + l * n + x] = A[k * s + l] * Gk[a * n + x];
-  }
-  for (i = 0; i < s; i++)
-    for (c = 0; c < n; c++)
-      for (a = 0; a < m; a++)
-        P->Jm[(i * n + c) * N + offM + a] = G0[a * n + c];
-  for (a = 0; a < m; a++)
-    for (l = 0; l < s; l++)
-      for (x = 0; x < n; x++)
-        P->Jm[(offM + a) * N + l * n + x] = b[l] * G1[a * n + x];
+  dm_prk_constr_terms(P->tab, n, m, P->nK, P->K, h, P->X, P->g, P->G, P->Hc, P->R,
+                      jac ? P->Jm : NULL);
   return DM_OK;
 }
 
@@ -239,10 +278,10 @@ int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
 int dm_prk_constr_finish(dm_prk *P, double h, const double *q0, const double *p0,
                          double *q1, double *p1, dm_err *e)
 {
-  size_t n = P->n, s = P->s, m = P->m, offL = P->sn, offM = P->sn + P->nK * m;
-  const double *b = P->tab->b, *G0 = P->G + s * m * n;
+  size_t n = P->n, s = P->s, m = P->m;
+  const double *b = P->tab->b;
   double *G1 = P->G + (s + 1) * m * n, *pp = P->p1w == p1 ? P->v1w : P->p1w;
-  size_t i, kk, a, c;
+  size_t i, c;
   int st;
   for (c = 0; c < n; c++) {
     double sq = 0.0, sp = 0.0;
@@ -251,16 +290,9 @@ int dm_prk_constr_finish(dm_prk *P, double h, const double *q0, const double *p0
       sp += b[i] * P->W[i * n + c];
     }
     P->dq[c] = h * sq;
-    sp *= h;
-    for (a = 0; a < m; a++)
-      sp -= G0[a * n + c] * P->X[offM + a];
-    for (kk = 0; kk < P->nK; kk++) {
-      const double *Gk = P->G + P->K[kk] * m * n;
-      for (a = 0; a < m; a++)
-        sp -= b[P->K[kk]] * Gk[a * n + c] * P->X[offL + kk * m + a];
-    }
-    P->dp[c] = sp;
+    P->dp[c] = sp * h;
   }
+  dm_prk_constr_momentum(P->tab, n, m, P->nK, P->K, P->X, P->G, P->dp);
   dm_prk_kahan(n, q0, P->dq, P->cq, q1);
   if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, P->g + (s + 1) * m, G1, NULL,
                            P->work, e)) != DM_OK)

@@ -9,6 +9,7 @@
 #define DM_PRK_KERNELS_H
 
 #include <stddef.h>
+#include "tableau.h"
 
 /* The stage predictor: the previous step's stage values hV (s x n, at the
  * nodes c of its step) extrapolated to the stage times of the next step,
@@ -18,5 +19,36 @@
  * caller invalidates it with *E_ratio = NAN.  X must not overlap hV. */
 void dm_prk_extrapolate(size_t s, size_t n, const double *c, double r, double *E,
                         double *E_ratio, const double *hV, double *X);
+
+/* {==== constraint multipliers (formulation: prk_constrained.c) ======== */
+
+/* The stages that carry multipliers with tableau t: none for one stage,
+ * the interior stages 1 .. s-2 of a Lobatto-type tableau (c_1 = 0, c_s = 1,
+ * first row of a zero, last row of a = b, last column of at zero, first
+ * column of at = b_1).  Sets *nK and K[0 .. *nK) (room for
+ * DM_TABLEAU_SMAX) and returns 1; returns 0 (nothing set) for any other
+ * tableau. */
+int dm_prk_constr_stages(const dm_tableau *t, size_t *nK, size_t *K);
+
+/* The multiplier terms of the constrained stage equations of tableau t on
+ * n coordinates with m constraints, multipliers at the nK stages K.
+ * Unknowns X = (V (s n), Lt_k (m each, k in K), mu0 (m)), N = s n + nK m + m
+ * of them.  g (m), G (m x n) and Hc (m x n x n: [a][c][x] = d2g_a/dq_c dq_x)
+ * hold the constraints at s + 2 points: slot k for stage k (Hc needed only
+ * for k in K and only with Jm), slot s for q0, slot s + 1 for q1.
+ *   R (N): adds G(q0)^T mu0 + sum_k at_ik G(Q_k)^T Lt_k to the stage rows,
+ *          writes the constraint rows g(Q_k)/h and g(q1)/h;
+ *   Jm (N x N, may be NULL): adds the curvature terms
+ *          sum_k at_ik h a_kl (Lt_k . d2g(Q_k)) to the stage block, writes
+ *          the multiplier columns and the constraint rows (their other
+ *          entries must be zero on entry). */
+void dm_prk_constr_terms(const dm_tableau *t, size_t n, size_t m, size_t nK, const size_t *K,
+                         double h, const double *X, const double *g, const double *G,
+                         const double *Hc, double *R, double *Jm);
+
+/* The multiplier impulses on the momentum increment of the step, with the
+ * layout above: dp -= G(q0)^T mu0 + sum_k b_k G(Q_k)^T Lt_k (n). */
+void dm_prk_constr_momentum(const dm_tableau *t, size_t n, size_t m, size_t nK, const size_t *K,
+                            const double *X, const double *G, double *dp);
 
 #endif
