@@ -26,7 +26,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -35,47 +34,11 @@ const dm_tableau *dm_rsprk_tableau(const dm_rsprk *P)
   return P->tab;
 }
 
-static void kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    double y = dx[i] - carry[i];
-    double t = x0[i] + y;
-    carry[i] = (t - x0[i]) - y;
-    out[i] = t;
-  }
-}
-
-/* Inline helpers of the hot path (the vectors are a few entries long: a
- * call to memcpy / memcmp / a norm loop costs more than the work). */
-static inline void vcopy(double *y, const double *x, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++)
-    y[i] = x[i];
-}
-
-static inline int vsame(const double *x, const double *y, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    uint64_t a, b;
-    memcpy(&a, x + i, sizeof a);
-    memcpy(&b, y + i, sizeof b);
-    if (a != b)
-      return 0;
-  }
-  return 1;
-}
-
-/* max(a, b), NaN when either is (fmax drops NaNs and is a libm call) */
-static inline double max2(double a, double b)
-{
-  return a > b || a != a ? a : b;
-}
-
 /* max |x_i|, NaN when some x_i is NaN or infinite (dm_rnorm_inf's
- * contract), with two independent max chains and no branch per entry */
+ * contract; the core's dm_norm_inf gives Inf for Inf), inline with two
+ * independent max chains and no branch per entry: the vectors are a few
+ * entries long and a call costs more than the work.  The other hot-path
+ * helpers are the core engine's (prk_kernels.h). */
 static inline double norm_inf(const double *x, size_t n)
 {
   double m0 = 0.0, m1 = 0.0, z0 = 0.0, z1 = 0.0;
@@ -258,23 +221,23 @@ static int eval_gyro(dm_rsprk *P, size_t i, const double *x, const double *v, in
   size_t d = P->d, dd = P->dd;
   const dm_rprog *pg = jac ? &red->gyro_j : &red->gyro_r;
   double *o = P->tout;
-  vcopy(P->tin, x, d);
-  vcopy(P->tin + d, v, d);
+  dm_vcopy(P->tin, x, d);
+  dm_vcopy(P->tin + d, v, d);
   dm_rprog_run(pg, P->tin, red->par, o, P->twork);
   if (!all_finite(o, pg->nout))
     return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", x, e);
-  vcopy(P->ga + i * d, o, d);
+  dm_vcopy(P->ga + i * d, o, d);
   if (!jac) {
-    vcopy(P->gkv + i * d, o + d, d);
-    vcopy(P->gib + i * d, o + 2 * d, d);
+    dm_vcopy(P->gkv + i * d, o + d, d);
+    dm_vcopy(P->gib + i * d, o + 2 * d, d);
     return DM_OK;
   }
-  vcopy(P->gK + i * dd, o + d, dd);
-  vcopy(P->gB + i * dd, o + d + dd, dd);
-  vcopy(P->gkv + i * d, o + d + 2 * dd, d);
-  vcopy(P->gib + i * d, o + 2 * d + 2 * dd, d);
-  vcopy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd);
-  vcopy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd);
+  dm_vcopy(P->gK + i * dd, o + d, dd);
+  dm_vcopy(P->gB + i * dd, o + d + dd, dd);
+  dm_vcopy(P->gkv + i * d, o + d + 2 * dd, d);
+  dm_vcopy(P->gib + i * d, o + 2 * d + 2 * dd, d);
+  dm_vcopy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd);
+  dm_vcopy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd);
   return DM_OK;
 }
 
@@ -284,13 +247,13 @@ static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, double 
   const dm_routh *red = P->red;
   size_t d = P->d, dd = P->dd, k;
   double *o = P->tout;
-  vcopy(P->tin, x, d);
+  dm_vcopy(P->tin, x, d);
   for (k = 0; k < d; k++)
     P->tin[d + k] = 0.0;
   dm_rprog_run(K ? &red->gyro_j : &red->gyro_r, P->tin, red->par, o, P->twork);
   if (!all_finite(o, K ? red->gyro_j.nout : d))
     return cb_fail(P, 1, "the connection mu^T A", x, e);
-  vcopy(a, o, d);
+  dm_vcopy(a, o, d);
   if (K)
     memcpy(K, o + d, dd * sizeof(double));
   if (B)
@@ -441,11 +404,11 @@ static double update_norm(const dm_rsprk *P, double h, const double *s0, double 
   size_t Sd = P->Sd, N = P->N;
   double ms = norm_inf(s0, P->d) + fabs(h) * norm_inf(P->Sdot, Sd);
   double lv = P->lvv_norm;
-  double vs = max2(max2(xv, lv > 0 ? ms / lv : 0.0), DBL_MIN);
+  double vs = dm_max3(xv, lv > 0 ? ms / lv : 0.0, DBL_MIN);
   double dn = rv / vs;
   if (N > Sd) {
-    double xs = max2(max2(norm_inf(P->X + Sd, N - Sd), ms), DBL_MIN);
-    dn = max2(dn, norm_inf(P->R + Sd, N - Sd) / xs);
+    double xs = dm_max3(norm_inf(P->X + Sd, N - Sd), ms, DBL_MIN);
+    dn = dm_max2(dn, norm_inf(P->R + Sd, N - Sd) / xs);
   }
   return dn;
 }
@@ -616,14 +579,14 @@ static int finish(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
   }
   if (P->m)
     return dm_rsprk_constr_finish(P, h, x0, s0, P->q1w, P->p1w, e);
-  kahan(d, x0, P->dq, P->cq, P->q1w);
+  dm_prk_kahan(d, x0, P->dq, P->cq, P->q1w);
   if (P->gyro) {
     if ((st = eval_node(P, P->q1w, P->a1, NULL, NULL, e)) != DM_OK)
       return st;
     for (a = 0; a < d; a++)
       P->dp[a] -= P->a1[a] - P->a0[a];
   }
-  kahan(d, s0, P->dp, P->cp, P->p1w);
+  dm_prk_kahan(d, s0, P->dp, P->cp, P->p1w);
   return DM_OK;
 }
 
@@ -635,8 +598,8 @@ static void group_increment(dm_rsprk *P, double h, double *dtheta)
   for (a = 0; a < r; a++)
     dtheta[a] = 0.0;
   for (j = 0; j < P->S; j++) {
-    vcopy(P->tin, P->Xs + j * d, d);
-    vcopy(P->tin + d, P->X + j * d, d);
+    dm_vcopy(P->tin, P->Xs + j * d, d);
+    dm_vcopy(P->tin + d, P->X + j * d, d);
     dm_rprog_run(&red->thd, P->tin, red->par, P->thd, P->twork);
     for (a = 0; a < r; a++)
       dtheta[a] += h * P->tab->b[j] * P->thd[a];
@@ -647,7 +610,7 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
                   double *s1, double *dtheta, dm_integ_stats *stt, dm_err *e)
 {
   size_t d = P->d, i;
-  int cont = P->hist && vsame(x0, P->hq1, d) && vsame(s0, P->hp1, d);
+  int cont = P->hist && dm_same(x0, P->hq1, d) && dm_same(s0, P->hp1, d);
   int st;
   if (!cont) {
     memset(P->cq, 0, d * sizeof(double));
@@ -665,7 +628,7 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
   st = cont ? DM_OK : dm_routh_check_inertia(P->red, x0, &P->sing_ref, P->twork, "the initial point", e);
   if (st == DM_OK && P->gyro) {
     if (cont)
-      vcopy(P->a0, P->a1, d);
+      dm_vcopy(P->a0, P->a1, d);
     else
       st = eval_node(P, x0, P->a0, NULL, NULL, e);
   }
@@ -689,15 +652,15 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
   }
   if (dtheta)
     group_increment(P, h, dtheta);
-  vcopy(P->hV, P->X, P->Sd);
+  dm_vcopy(P->hV, P->X, P->Sd);
   if (P->N > P->Sd)
-    vcopy(P->hx, P->X + P->Sd, P->N - P->Sd);
-  vcopy(P->hq1, P->q1w, d);
-  vcopy(P->hp1, P->p1w, d);
+    dm_vcopy(P->hx, P->X + P->Sd, P->N - P->Sd);
+  dm_vcopy(P->hq1, P->q1w, d);
+  dm_vcopy(P->hp1, P->p1w, d);
   P->hist_h = h;
   P->hist = 1;
-  vcopy(x1, P->q1w, d);
-  vcopy(s1, P->p1w, d);
+  dm_vcopy(x1, P->q1w, d);
+  dm_vcopy(s1, P->p1w, d);
   if (stt)
     stt->steps++;
   return DM_OK;

@@ -111,17 +111,6 @@ int dm_rsprk_project(dm_rsprk *P, const double *x1, const double *G1, double *s,
   return DM_OK;
 }
 
-static void kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    double yy = dx[i] - carry[i];
-    double t = x0[i] + yy;
-    carry[i] = (t - x0[i]) - yy;
-    out[i] = t;
-  }
-}
-
 int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double *s0, double *x1,
                            double *s1, dm_err *e)
 {
@@ -132,7 +121,7 @@ int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double
   int st;
   (void)h;
   dm_prk_constr_momentum(P->tab, d, m, P->nK, P->K, P->X, P->G, P->dp);
-  kahan(d, x0, P->dq, P->cq, x1);
+  dm_prk_kahan(d, x0, P->dq, P->cq, x1);
   if (P->gyro) {
     double *o = P->tout;
     memcpy(P->tin, x1, d * sizeof(double));
@@ -152,6 +141,6 @@ int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double
     return st;
   for (c = 0; c < d; c++)
     P->dp[c] += P->tmp[c] - pp[c];
-  kahan(d, s0, P->dp, P->cp, s1);
+  dm_prk_kahan(d, s0, P->dp, P->cp, s1);
   return DM_OK;
 }

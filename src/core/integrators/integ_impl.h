@@ -21,6 +21,7 @@
 #include <gsl/gsl_permutation.h>
 #include "integrator.h"
 #include "newton.h"
+#include "prk_kernels.h"
 #include "smalllu.h"
 
 /* {==== checked evaluation ============================================== */
@@ -55,41 +56,6 @@ static inline int dm_eval_constr(const dm_system *sys, const double *q, unsigned
 /* "(x1, x2, ...)" into buf (at most 6 entries). */
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n);
 
-/* y = x, n doubles, as an inline loop: the copies of a step are a few
- * doubles each and a memcpy call costs more than the copy.  (No restrict:
- * GCC would turn the loop back into a memmove call.) */
-static inline void dm_vcopy(double *y, const double *x, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++)
-    y[i] = x[i];
-}
-
-/* x and y bitwise equal (memcmp semantics, inline). */
-static inline int dm_same(const double *x, const double *y, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    uint64_t a, b;
-    memcpy(&a, x + i, sizeof a);
-    memcpy(&b, y + i, sizeof b);
-    if (a != b)
-      return 0;
-  }
-  return 1;
-}
-
-/* max(a, b), NaN when either is NaN (fmax drops NaNs and is a libm call
- * at -O2). */
-static inline double dm_max2(double a, double b)
-{
-  return a > b || a != a ? a : b;
-}
-
-static inline double dm_max3(double a, double b, double c)
-{
-  return dm_max2(dm_max2(a, b), c);
-}
 
 /* max |x_i|, NaN when some x_i is NaN (+-Inf gives Inf).  Inline and
  * without a branch per entry: it runs several times per Newton iteration on

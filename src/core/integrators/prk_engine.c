@@ -152,17 +152,6 @@ int dm_prk_is_explicit(const dm_prk *P)
   return P->explicit_sv;
 }
 
-void dm_prk_kahan(size_t n, const double *x0, const double *dx, double *carry, double *out)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    double y = dx[i] - carry[i];
-    double t = x0[i] + y;
-    carry[i] = (t - x0[i]) - y;
-    out[i] = t;
-  }
-}
-
 /* Evaluate L (and the force) at stage i: gradients always, second
  * derivatives when jac; W, D, Bm derived. */
 int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)

@@ -59,7 +59,6 @@ struct dm_prk {
 
 /* prk_engine.c */
 int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e);
-void dm_prk_kahan(size_t n, const double *x0, const double *dx, double *carry, double *out);
 int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e);
 
 /* prk_constrained.c */
