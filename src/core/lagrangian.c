@@ -3,6 +3,7 @@
  * lagrangian.h. */
 #include <config.h>
 #include "lagrangian.h"
+#include "bundle.h"
 #include "tape.h"
 
 #include <float.h>
@@ -13,50 +14,20 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_linalg.h>
 
-/* A compiled bundle of outputs: the tape and, when available, native code
- * computing the same thing. */
-typedef struct prog {
-  dm_tape *tape;
-  dm_native *nat;
-  dm_native_fn fn;
-  dm_native_scatter_fn scatter;   /* native, writing the caller's arrays */
-  size_t nout, nregs;
-  /* tape path: the outputs are laid out in the tape's slots (registers
-   * from slot0) exactly as in the arrays: array a is slots aoff[a] ..
-   * aoff[a+1] */
-  size_t slot0;
-  uint32_t narr, aoff[33];
-  uint32_t nchk, *chk;            /* the registers to test for NaN/Inf */
-  size_t nin;                     /* inputs: 2n (q, v), or n (q only) */
-  unsigned have;                  /* bits of the arrays it fills */
-  unsigned fill;                  /* Lagrangian bundles: mask bits always
-                                     passed (L, whose storage is always
-                                     there, and the arrays it lacks), so
-                                     that a request of all it has takes
-                                     the direct path */
-} prog;
-
 typedef struct lag_data {
   size_t n, m, npar;
   char *name;
   char **coords, **params;
   double *par, *mass;
-  prog grad, all;             /* L, Lq, Lv | + Lvv, Lvq, Lqq */
-  prog lq, qvqq;              /* separable L: Lq (of q alone) | Lq, Lv, Lqq */
-  const prog *sel[DM_LAG_ALL + 1];  /* the cheapest bundle for each request */
-  prog force, force_all;      /* F | + Fq, Fv */
-  prog constr, constr_all;    /* g, G | + H */
-  prog massp;                 /* Lvv (n*n) when constant in q and v */
+  /* compiled bundles of outputs (bundle.h) */
+  dm_bundle grad, all;        /* L, Lq, Lv | + Lvv, Lvq, Lqq */
+  dm_bundle lq, qvqq;         /* separable L: Lq (of q alone) | Lq, Lv, Lqq */
+  const dm_bundle *sel[DM_LAG_ALL + 1];  /* the cheapest bundle for each request */
+  dm_bundle force, force_all; /* F | + Fq, Fv */
+  dm_bundle constr, constr_all;  /* g, G | + H */
+  dm_bundle massp;            /* Lvv (n*n) when constant in q and v */
   int mass_possible;
 } lag_data;
-
-static void prog_free(prog *p)
-{
-  free(p->chk);
-  dm_native_free(p->nat);
-  dm_tape_free(p->tape);
-  memset(p, 0, sizeof *p);
-}
 
 static void lag_free_data(lag_data *d)
 {
@@ -71,10 +42,10 @@ static void lag_free_data(lag_data *d)
   free(d->name);
   free(d->par);
   free(d->mass);
-  prog *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force, &d->force_all,
-                 &d->constr, &d->constr_all, &d->massp };
+  dm_bundle *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force, &d->force_all,
+                      &d->constr, &d->constr_all, &d->massp };
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
-    prog_free(ps[i]);
+    dm_bundle_free(ps[i]);
   free(d);
 }
 
@@ -85,48 +56,8 @@ static void lag_free(dm_system *s)
 }
 
 /* Inputs are written straight into the tape's register file (its first
- * registers are the inputs), so neither path copies them twice; outputs
- * go after the registers. */
-static inline double *prog_run(const prog *p, double *w, const double *par)
-{
-  double *o = w + p->nregs;
-  if (p->fn != NULL)
-    p->fn(w, par, o);
-  else
-    dm_tape_eval(p->tape, w, par, o, w);
-  return o;
-}
-
-/* Bit 63 set when x is NaN or infinite (its exponent is all ones): ORed
- * over many values without floating-point compares. */
-static inline uint64_t nonfinite_bit(double x)
-{
-  uint64_t u;
-  memcpy(&u, &x, sizeof u);
-  return (u & 0x7ff0000000000000ULL) + 0x0010000000000000ULL;
-}
-
-/* The tape path of a callback: run on the inputs already in w (its slots
- * then hold the arrays' contents), test every output for NaN/Inf,
- * requested or not, as native code does, copy the arrays whose bit is in
- * mask.  Returns 1 (nothing written) when an output is NaN or Inf. */
-static int tape_scatter(const prog *p, double *w, const double *par,
-                        double *const *out, unsigned mask)
-{
-  dm_tape_run(p->tape, w, par, w);
-  const uint32_t *chk = p->chk, nchk = p->nchk;
-  uint64_t bad = 0;
-  for (uint32_t j = 0; j < nchk; j++)
-    bad |= nonfinite_bit(w[chk[j]]);
-  if (bad >> 63)
-    return 1;             /* outside the domain: retry with another step */
-  const double *v = w + p->slot0;
-  for (uint32_t a = 0; a < p->narr; a++)
-    if (mask & (1u << a))
-      dm_copy_doubles(out[a], v + p->aoff[a], p->aoff[a + 1] - p->aoff[a]);
-  return 0;
-}
-
+ * registers are the inputs), so neither path copies them twice; the tape
+ * path of a callback is dm_bundle_tape_scatter. */
 static inline void copy(double *dst, const double *src, size_t k)
 {
   for (size_t i = 0; i < k; i++)
@@ -147,13 +78,16 @@ static int nonfinite(const double *x, size_t k)
  * callbacks
  * =================================================================== */
 
+/* The request mask is passed with L (whose storage is always there) and
+ * the arrays the bundle lacks (p->fill) set, so that a request of all the
+ * bundle has takes native code's direct path. */
 static int lag_eval(void *data, const double *q, const double *v,
                     const double *par, unsigned what, dm_lag_out *out,
                     void *work)
 {
   const lag_data *d = data;
   const size_t n = d->n;
-  const prog *p = d->sel[what & DM_LAG_ALL];
+  const dm_bundle *p = d->sel[what & DM_LAG_ALL];
   double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
@@ -163,7 +97,7 @@ static int lag_eval(void *data, const double *q, const double *v,
   copy(w, q, n);
   if (p->nin > n)
     copy(w + n, v, n);
-  return tape_scatter(p, w, par, o, what | DM_LAG_L | p->fill);
+  return dm_bundle_tape_scatter(p, w, par, o, what | DM_LAG_L | p->fill);
 }
 
 static int force_eval(void *data, const double *q, const double *v,
@@ -172,7 +106,7 @@ static int force_eval(void *data, const double *q, const double *v,
 {
   const lag_data *d = data;
   const size_t n = d->n;
-  const prog *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  const dm_bundle *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
   double *o[3] = { F, Fq, Fv };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
@@ -181,7 +115,7 @@ static int force_eval(void *data, const double *q, const double *v,
   double *w = work;
   copy(w, q, n);
   copy(w + n, v, n);
-  return tape_scatter(p, w, par, o, what);
+  return dm_bundle_tape_scatter(p, w, par, o, what);
 }
 
 static int constr_eval(void *data, const double *q, const double *par,
@@ -189,7 +123,7 @@ static int constr_eval(void *data, const double *q, const double *par,
                        void *work)
 {
   const lag_data *d = data;
-  const prog *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
+  const dm_bundle *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
   double *o[3] = { g, G, H };
   if (p->scatter != NULL) {
     const double *in[1] = { q };
@@ -197,7 +131,7 @@ static int constr_eval(void *data, const double *q, const double *par,
   }
   double *w = work;
   copy(w, q, d->n);
-  return tape_scatter(p, w, par, o, what);
+  return dm_bundle_tape_scatter(p, w, par, o, what);
 }
 
 /* {==================================================================
@@ -219,144 +153,17 @@ static int ctx_fail(builder *b, const char *what)
                     what, e->msg[0] ? e->msg : "cannot build the derivatives");
 }
 
-/* Where the outputs of a bundle go: blocks of one array each, in output
- * order -- vectors, full matrices, symmetric matrices (packed upper
- * triangles, written to both halves), `rep` times at a stride. */
-enum { BLK_VEC, BLK_FULL, BLK_SYM };
-typedef struct block {
-  unsigned arr, kind;
-  size_t len;               /* vector length or matrix order */
-  size_t rep, stride;       /* repetitions (constraint Hessians) */
-} block;
-
-/* Output map for the blocks, cut at nout outputs; *nmap entries. */
-static dm_native_map *make_outmap(const block *blk, size_t nblk, size_t nout,
-                                  size_t *nmap)
-{
-  size_t cap = 2 * nout + 1, j = 0, k = 0;
-  dm_native_map *m = malloc(cap * sizeof *m);
-  if (m == NULL)
-    return NULL;
-  for (size_t bi = 0; bi < nblk && k < nout; bi++) {
-    const block *B = &blk[bi];
-    size_t n = B->len;
-    for (size_t r = 0; r < B->rep && k < nout; r++) {
-      uint32_t off = (uint32_t)(r * B->stride);
-      if (B->kind == BLK_VEC) {
-        for (size_t i = 0; i < n && k < nout; i++, k++)
-          m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)i };
-      } else if (B->kind == BLK_FULL) {
-        for (size_t i = 0; i < n * n && k < nout; i++, k++)
-          m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)i };
-      } else {
-        for (size_t i = 0; i < n; i++)
-          for (size_t c = i; c < n && k < nout; c++, k++) {
-            m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)(i * n + c) };
-            if (c != i)
-              m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)(c * n + i) };
-          }
-      }
-    }
-  }
-  *nmap = j;
-  return m;
-}
-
-/* Compile a bundle: the tape, and native code (with its scattering
- * function for the blocks) when the mode asks for it.  exact: out was
- * rewritten by dm_tape_optimize already (so that bundles sharing outputs
- * compute them identically). */
-static int compile_prog(builder *b, prog *p, size_t nout, const dm_expr *out,
-                        size_t nin, const block *blk, size_t nblk, int exact)
+/* Compile a bundle on (q, v) or q alone: the tape, and native code (with
+ * its scattering function for the blocks) when the mode asks for it.
+ * exact: out was rewritten by dm_tape_optimize already (so that bundles
+ * sharing outputs compute them identically). */
+static int compile_bundle(builder *b, dm_bundle *p, size_t nout, const dm_expr *out,
+                        size_t nin, const dm_block *blk, size_t nblk, int exact)
 {
   const dm_lagrangian_spec *sp = b->sp;
-  size_t nmap = 0, n = sp->n;
-  dm_native_map *inmap = malloc((nin + 1) * sizeof *inmap);
-  dm_native_map *outmap = make_outmap(blk, nblk, nout, &nmap);
-  uint32_t *slot_out = malloc((nmap + 1) * sizeof *slot_out);
-  if (inmap == NULL || outmap == NULL || slot_out == NULL) {
-    free(inmap);
-    free(outmap);
-    free(slot_out);
-    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
-  }
-  /* the arrays laid out one after the other in the tape's slots (the
-   * blocks fill their arrays densely) */
-  uint32_t size[32] = { 0 };
-  p->narr = 0;
-  for (size_t j = 0; j < nmap; j++) {
-    uint32_t a = outmap[j].arr;
-    if (a + 1 > p->narr)
-      p->narr = a + 1;
-    if (outmap[j].elem + 1 > size[a])
-      size[a] = outmap[j].elem + 1;
-  }
-  p->aoff[0] = 0;
-  p->have = 0;
-  for (uint32_t a = 0; a < p->narr; a++) {
-    p->aoff[a + 1] = p->aoff[a] + size[a];
-    p->have |= size[a] ? 1u << a : 0u;
-  }
-  p->fill = (p->narr >= 32 ? ~0u : (1u << p->narr) - 1) & ~p->have;
-  p->nin = nin;
-  int s = p->aoff[p->narr] == nmap ? DM_OK
-          : dm_err_set(b->err, DM_EFAILED, "internal: output blocks leave gaps");
-  for (size_t j = 0; j < nmap; j++)
-    slot_out[p->aoff[outmap[j].arr] + outmap[j].elem] = outmap[j].k;
-  if (s == DM_OK && nmap > 0)
-    s = dm_tape_compile_slots(b->ctx, nout, out, nin, b->in, sp->npar,
-                              sp->par, nmap, slot_out, &p->tape, b->err);
-  else if (s == DM_OK)
-    s = (exact ? dm_tape_compile_exact : dm_tape_compile)(b->ctx, nout,
-        out, nin, b->in, sp->npar, sp->par, &p->tape, b->err);
-  free(slot_out);
-  if (s != DM_OK) {
-    free(inmap);
-    free(outmap);
-    return s;
-  }
-  p->nout = nout;
-  p->nregs = dm_tape_work_size(p->tape);
-  p->slot0 = dm_tape_slot_base(p->tape);
-  /* the distinct output registers that are not constants */
-  const uint32_t *oreg = dm_tape_outregs(p->tape);
-  size_t c0 = dm_tape_nin(p->tape) + dm_tape_npar(p->tape);
-  size_t c1 = c0 + dm_tape_nconst(p->tape);
-  p->chk = malloc((nout + 1) * sizeof *p->chk);
-  if (p->chk == NULL) {
-    free(inmap);
-    free(outmap);
-    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
-  }
-  p->nchk = 0;
-  for (size_t k = 0; k < nout; k++) {
-    int dup = oreg[k] >= c0 && oreg[k] < c1;
-    for (uint32_t j = 0; j < p->nchk && !dup; j++)
-      dup = p->chk[j] == oreg[k];
-    if (!dup)
-      p->chk[p->nchk++] = oreg[k];
-  }
-  if (sp->native == DM_NATIVE_NEVER) {
-    free(inmap);
-    free(outmap);
-    return DM_OK;
-  }
-  for (size_t i = 0; i < nin; i++)           /* q, then v */
-    inmap[i] = (dm_native_map){ (uint32_t)i, (uint32_t)(i / n), (uint32_t)(i % n) };
-  dm_err nerr;
-  s = dm_native_compile_mapped(p->tape, b->in0, sp->par_values, inmap, nmap,
-                               outmap, &p->nat, &nerr);
-  free(inmap);
-  free(outmap);
-  if (s == DM_OK) {
-    p->fn = dm_native_function(p->nat);
-    p->scatter = dm_native_scatter(p->nat);
-  } else if (sp->native == DM_NATIVE_ALWAYS || s == DM_EINTR) {
-    if (b->err != NULL)
-      *b->err = nerr;
-    return s;
-  }
-  return DM_OK;             /* auto: the tape runs, silently */
+  dm_bundle_src src = { b->ctx, b->in, sp->n, sp->npar, sp->par, b->in0,
+                        sp->par_values, sp->native };
+  return dm_bundle_compile(p, &src, nout, out, nin, blk, nblk, exact, b->err);
 }
 
 /* Every symbol or parameter in e must be one of allowed[0..na). */
@@ -421,7 +228,7 @@ static int eval_mass(lag_data *d)
   double *buf = calloc(nw + 2 * n * n + 1, sizeof *buf);
   if (buf == NULL)
     return 0;
-  const double *M0 = prog_run(&d->massp, buf, d->par);  /* q = v = 0 */
+  const double *M0 = dm_bundle_run_plain(&d->massp, buf, d->par);  /* q = v = 0 */
   memcpy(d->mass, M0, n * n * sizeof *buf);
   double *A = buf + nw + n * n;
   memcpy(A, M0, n * n * sizeof *buf);
@@ -475,7 +282,7 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
   dm_lagrangian_spec tsp = *sp;
   tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
   nb.sp = &tsp;
-  s = compile_prog(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0, 0);
+  s = compile_bundle(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0, 0);
   if (s != DM_OK)
     return s;
   d->mass_possible = 1;
@@ -491,12 +298,12 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
  * whose compilation failed falls back to its tape alone). */
 static void select_progs(lag_data *d)
 {
-  const prog *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
+  const dm_bundle *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
   for (unsigned w = 0; w <= DM_LAG_ALL; w++) {
-    const prog *best = &d->all;
+    const dm_bundle *best = &d->all;
     size_t bc = SIZE_MAX;
     for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
-      const prog *p = ps[i];
+      const dm_bundle *p = ps[i];
       if (p->tape == NULL || (w & ~p->have) != 0)
         continue;
       size_t c = dm_tape_ninstr(p->tape) + ((p->have & ~(w | DM_LAG_L)) ? p->nout : 0);
@@ -550,9 +357,9 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     for (size_t j = i; j < n; j++)
       *o++ = H[i * m + j];
   free(H);
-  const block blk[] = { { 0, BLK_VEC, 1, 1, 0 }, { 1, BLK_VEC, n, 1, 0 },
-                        { 2, BLK_VEC, n, 1, 0 }, { 3, BLK_SYM, n, 1, 0 },
-                        { 4, BLK_FULL, n, 1, 0 }, { 5, BLK_SYM, n, 1, 0 } };
+  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0 }, { 1, DM_BLK_VEC, n, 1, 0 },
+                        { 2, DM_BLK_VEC, n, 1, 0 }, { 3, DM_BLK_SYM, n, 1, 0 },
+                        { 4, DM_BLK_FULL, n, 1, 0 }, { 5, DM_BLK_SYM, n, 1, 0 } };
   /* rewritten once for both bundles: the gradient alone and with the
    * Hessian are computed the same way, bit for bit */
   dm_expr *ow = malloc(nall * sizeof *ow);
@@ -561,8 +368,8 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     goto done;
   }
   if ((s = dm_tape_optimize(b->ctx, nall, out, ow, b->err)) != DM_OK ||
-      (s = compile_prog(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = compile_prog(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
       (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK) {
     free(ow);
     goto done;
@@ -572,12 +379,12 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
      * integrators ask for Lq alone (Stormer-Verlet) or for Lq, Lv, Lqq
      * (the Newton matrix, Lvv being the mass); both bundles from the same
      * rewritten outputs, so their values are those of grad and all */
-    const block bq[] = { { 1, BLK_VEC, n, 1, 0 } };
-    const block bqv[] = { { 1, BLK_VEC, n, 1, 0 }, { 2, BLK_VEC, n, 1, 0 },
-                          { 5, BLK_SYM, n, 1, 0 } };
+    const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0 } };
+    const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0 }, { 2, DM_BLK_VEC, n, 1, 0 },
+                          { 5, DM_BLK_SYM, n, 1, 0 } };
     memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
-    if ((s = compile_prog(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
-        (s = compile_prog(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK) {
+    if ((s = compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
+        (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK) {
       free(ow);
       goto done;
     }
@@ -599,8 +406,8 @@ static int build_force(builder *b, lag_data *d)
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->force, n * sizeof *out);
-  const block blk[] = { { 0, BLK_VEC, n, 1, 0 }, { 1, BLK_FULL, n, 1, 0 },
-                        { 2, BLK_FULL, n, 1, 0 } };
+  const dm_block blk[] = { { 0, DM_BLK_VEC, n, 1, 0 }, { 1, DM_BLK_FULL, n, 1, 0 },
+                        { 2, DM_BLK_FULL, n, 1, 0 } };
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, n, sp->force, n, sp->q, out + n, NULL) != DM_OK ||
       dm_expr_jacobian(b->ctx, n, sp->force, n, sp->v, out + n + n * n, NULL) != DM_OK)
@@ -608,9 +415,9 @@ static int build_force(builder *b, lag_data *d)
   if (s == DM_OK)
     s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
   if (s == DM_OK)
-    s = compile_prog(b, &d->force, n, out, 2 * n, blk, 3, 1);
+    s = compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
   if (s == DM_OK)
-    s = compile_prog(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
+    s = compile_bundle(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
   free(out);
   return s;
 }
@@ -624,8 +431,8 @@ static int build_constraints(builder *b, lag_data *d)
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->constraints, m * sizeof *out);
-  const block blk[] = { { 0, BLK_VEC, m, 1, 0 }, { 1, BLK_VEC, m * n, 1, 0 },
-                        { 2, BLK_SYM, n, m, n * n } };
+  const dm_block blk[] = { { 0, DM_BLK_VEC, m, 1, 0 }, { 1, DM_BLK_VEC, m * n, 1, 0 },
+                        { 2, DM_BLK_SYM, n, m, n * n } };
   dm_expr *G = out + m, *o = out + m + m * n;
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)
@@ -639,9 +446,9 @@ static int build_constraints(builder *b, lag_data *d)
   if (s == DM_OK)
     s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr, m + m * n, out, n, blk, 3, 1);
+    s = compile_bundle(b, &d->constr, m + m * n, out, n, blk, 3, 1);
   if (s == DM_OK)
-    s = compile_prog(b, &d->constr_all, nall, out, n, blk, 3, 1);
+    s = compile_bundle(b, &d->constr_all, nall, out, n, blk, 3, 1);
   free(out);
   return s;
 }
@@ -686,7 +493,7 @@ static int check_spec(builder *b)
   return s;
 }
 
-static size_t prog_need(const prog *p)
+static size_t bundle_need(const dm_bundle *p)
 {
   return p->tape ? p->nregs + p->nout : 0;
 }
@@ -730,11 +537,11 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
     goto fail;
 
   size_t need = 0;
-  const prog *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force,
-                       &d->force_all, &d->constr, &d->constr_all };
+  const dm_bundle *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force,
+                            &d->force_all, &d->constr, &d->constr_all };
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
-    if (prog_need(ps[i]) > need)
-      need = prog_need(ps[i]);
+    if (bundle_need(ps[i]) > need)
+      need = bundle_need(ps[i]);
   sys->name = d->name;
   sys->n = n;
   sys->npar = sp->npar;
