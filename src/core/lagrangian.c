@@ -318,62 +318,64 @@ static void select_progs(lag_data *d)
   }
 }
 
+int dm_lagrangian_outputs(dm_expr_ctx *ctx, dm_expr L, size_t n, const dm_expr *in,
+                          dm_expr *out, dm_expr *ow, dm_err *err)
+{
+  size_t m = 2 * n, tri = n * (n + 1) / 2;
+  dm_expr *H = malloc(m * m * sizeof *H), *o = out + 1 + 2 * n;
+  if (H == NULL)
+    return dm_err_set(err, DM_ENOMEM, "out of memory");
+  out[0] = L;
+  /* gradient and Hessian in (q, v) at once: the Hessian routine shares the
+   * chain rule through common subexpressions between all the blocks */
+  if (dm_expr_grad(ctx, L, m, in, out + 1, NULL) != DM_OK ||
+      dm_expr_hessian(ctx, L, m, in, H, NULL) != DM_OK) {
+    const dm_err *ce = dm_expr_ctx_err(ctx);
+    free(H);
+    return dm_err_set(err, ce->status ? ce->status : DM_EFAILED, "L: %s",
+                      ce->msg[0] ? ce->msg : "cannot build the derivatives");
+  }
+  for (size_t i = 0; i < n; i++)            /* Lvv, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = H[(n + i) * m + n + j];
+  for (size_t i = 0; i < n; i++)            /* Lvq, full */
+    for (size_t j = 0; j < n; j++)
+      *o++ = H[(n + i) * m + j];
+  for (size_t i = 0; i < n; i++)            /* Lqq, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = H[i * m + j];
+  free(H);
+  return dm_tape_optimize(ctx, 1 + 2 * n + 2 * tri + n * n, out, ow, err);
+}
+
 /* L and its derivatives: tapes grad and all, and the structure flags. */
 static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
 {
   const dm_lagrangian_spec *sp = b->sp;
   size_t n = sp->n, tri = n * (n + 1) / 2;
   size_t nall = 1 + 2 * n + 2 * tri + n * n;
-  dm_expr *out = malloc(nall * sizeof *out);
-  dm_expr *Lvv = malloc(n * n * sizeof *Lvv), *Lvq = malloc(n * n * sizeof *Lvq);
+  dm_expr *out = malloc(nall * sizeof *out), *ow = malloc(nall * sizeof *ow);
+  dm_expr *Lvv = malloc(n * n * sizeof *Lvv);
   int s = DM_ENOMEM;
-  if (!out || !Lvv || !Lvq) {
+  if (!out || !ow || !Lvv) {
     dm_err_set(b->err, s, "out of memory");
     goto done;
   }
-  dm_expr *Lv = out + 1 + n, *o = out + 1 + 2 * n;
-  size_t m = 2 * n;
-  dm_expr *H = malloc(m * m * sizeof *H);
-  out[0] = sp->L;
-  if (H == NULL) {
-    s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
-    goto done;
-  }
-  /* gradient and Hessian in (q, v) at once: the Hessian routine shares the
-   * chain rule through common subexpressions between all the blocks */
-  if (dm_expr_grad(b->ctx, sp->L, m, b->in, out + 1, NULL) != DM_OK ||
-      dm_expr_hessian(b->ctx, sp->L, m, b->in, H, NULL) != DM_OK) {
-    free(H);
-    s = ctx_fail(b, "L");
-    goto done;
-  }
-  for (size_t i = 0; i < n; i++)            /* Lvv, upper triangle */
-    for (size_t j = i; j < n; j++)
-      *o++ = Lvv[i * n + j] = Lvv[j * n + i] = H[(n + i) * m + n + j];
-  for (size_t i = 0; i < n; i++)            /* Lvq, full */
-    for (size_t j = 0; j < n; j++)
-      *o++ = Lvq[i * n + j] = H[(n + i) * m + j];
-  for (size_t i = 0; i < n; i++)            /* Lqq, upper triangle */
-    for (size_t j = i; j < n; j++)
-      *o++ = H[i * m + j];
-  free(H);
-  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0 }, { 1, DM_BLK_VEC, n, 1, 0 },
-                        { 2, DM_BLK_VEC, n, 1, 0 }, { 3, DM_BLK_SYM, n, 1, 0 },
-                        { 4, DM_BLK_FULL, n, 1, 0 }, { 5, DM_BLK_SYM, n, 1, 0 } };
   /* rewritten once for both bundles: the gradient alone and with the
    * Hessian are computed the same way, bit for bit */
-  dm_expr *ow = malloc(nall * sizeof *ow);
-  if (ow == NULL) {
-    s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  if ((s = dm_lagrangian_outputs(b->ctx, sp->L, n, b->in, out, ow, b->err)) != DM_OK)
     goto done;
-  }
-  if ((s = dm_tape_optimize(b->ctx, nall, out, ow, b->err)) != DM_OK ||
-      (s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+  const dm_expr *Lv = out + 1 + n, *Lvq = out + 1 + 2 * n + tri;
+  for (size_t i = 0, k = 1 + 2 * n; i < n; i++)
+    for (size_t j = i; j < n; j++, k++)
+      Lvv[i * n + j] = Lvv[j * n + i] = out[k];
+  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0 }, { 1, DM_BLK_VEC, n, 1, 0 },
+                           { 2, DM_BLK_VEC, n, 1, 0 }, { 3, DM_BLK_SYM, n, 1, 0 },
+                           { 4, DM_BLK_FULL, n, 1, 0 }, { 5, DM_BLK_SYM, n, 1, 0 } };
+  if ((s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
       (s = compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK) {
-    free(ow);
+      (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK)
     goto done;
-  }
   if (d->mass_possible) {
     /* separable (Lvq = 0, Lvv constant): Lq depends on q alone, and the
      * integrators ask for Lq alone (Stormer-Verlet) or for Lq, Lv, Lqq
@@ -381,21 +383,31 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
      * rewritten outputs, so their values are those of grad and all */
     const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0 } };
     const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0 }, { 2, DM_BLK_VEC, n, 1, 0 },
-                          { 5, DM_BLK_SYM, n, 1, 0 } };
+                             { 5, DM_BLK_SYM, n, 1, 0 } };
     memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
     if ((s = compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
-        (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK) {
-      free(ow);
+        (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
       goto done;
-    }
   }
-  free(ow);
   select_progs(d);
 done:
   free(out);
+  free(ow);
   free(Lvv);
-  free(Lvq);
   return s;
+}
+
+int dm_lagrangian_force_outputs(dm_expr_ctx *ctx, size_t n, const dm_expr *F,
+                                const dm_expr *in, dm_expr *out, dm_err *err)
+{
+  memcpy(out, F, n * sizeof *out);
+  if (dm_expr_jacobian(ctx, n, F, n, in, out + n, NULL) != DM_OK ||
+      dm_expr_jacobian(ctx, n, F, n, in + n, out + n + n * n, NULL) != DM_OK) {
+    const dm_err *ce = dm_expr_ctx_err(ctx);
+    return dm_err_set(err, ce->status ? ce->status : DM_EFAILED, "force: %s",
+                      ce->msg[0] ? ce->msg : "cannot build the derivatives");
+  }
+  return dm_tape_optimize(ctx, n + 2 * n * n, out, out, err);
 }
 
 static int build_force(builder *b, lag_data *d)
@@ -405,15 +417,9 @@ static int build_force(builder *b, lag_data *d)
   dm_expr *out = malloc(nall * sizeof *out);
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
-  memcpy(out, sp->force, n * sizeof *out);
   const dm_block blk[] = { { 0, DM_BLK_VEC, n, 1, 0 }, { 1, DM_BLK_FULL, n, 1, 0 },
-                        { 2, DM_BLK_FULL, n, 1, 0 } };
-  int s = DM_OK;
-  if (dm_expr_jacobian(b->ctx, n, sp->force, n, sp->q, out + n, NULL) != DM_OK ||
-      dm_expr_jacobian(b->ctx, n, sp->force, n, sp->v, out + n + n * n, NULL) != DM_OK)
-    s = ctx_fail(b, "force");
-  if (s == DM_OK)
-    s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
+                           { 2, DM_BLK_FULL, n, 1, 0 } };
+  int s = dm_lagrangian_force_outputs(b->ctx, n, sp->force, b->in, out, b->err);
   if (s == DM_OK)
     s = compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
   if (s == DM_OK)
@@ -432,7 +438,7 @@ static int build_constraints(builder *b, lag_data *d)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->constraints, m * sizeof *out);
   const dm_block blk[] = { { 0, DM_BLK_VEC, m, 1, 0 }, { 1, DM_BLK_VEC, m * n, 1, 0 },
-                        { 2, DM_BLK_SYM, n, m, n * n } };
+                           { 2, DM_BLK_SYM, n, m, n * n } };
   dm_expr *G = out + m, *o = out + m + m * n;
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)

@@ -70,6 +70,21 @@ typedef struct dm_lagrangian_spec {
 int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *spec,
                           dm_system *sys, dm_err *err);
 
+/* The outputs the compiled system computes, for programs that compute
+ * some of them along with other things (the Routh reduction's stage
+ * programs) and must agree with the system bit for bit.  in: q then v (2n
+ * symbols).  out gets L, Lq (n), Lv (n), Lvv (upper triangle, row by row),
+ * Lvq (n x n, [i][j] = d2L/dv_i dq_j), Lqq (upper triangle): 1 + 2n +
+ * n(n+1) + n^2 nodes; ow the same rewritten as the system's bundles compute
+ * them (dm_tape_optimize).  Errors: the context's failure ("L: ..."),
+ * DM_ENOMEM. */
+int dm_lagrangian_outputs(dm_expr_ctx *ctx, dm_expr L, size_t n, const dm_expr *in,
+                          dm_expr *out, dm_expr *ow, dm_err *err);
+/* The same for a force F (n): out gets F, Fq (n x n), Fv (n x n),
+ * rewritten. */
+int dm_lagrangian_force_outputs(dm_expr_ctx *ctx, size_t n, const dm_expr *F,
+                                const dm_expr *in, dm_expr *out, dm_err *err);
+
 /* Re-evaluate `mass` after sys->par changed (no-op for a system whose Lvv
  * is not constant in q and v).  DM_EINVAL if sys was not made here. */
 int dm_lagrangian_refresh(dm_system *sys, dm_err *err);

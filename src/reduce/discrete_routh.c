@@ -135,16 +135,8 @@ static int conn_at(dm_routh_dr *dr, const double *x, int deriv, dm_err *e)
 
 static int muA_at(dm_routh_dr *dr, const double *x, double *a, dm_err *e)
 {
-  const dm_routh *red = dr->red;
-  size_t d = dr->d, i;
-  memcpy(dr->tin, x, d * sizeof(double));
-  memset(dr->tin + d, 0, d * sizeof(double));
-  dm_rprog_run(&red->gyro_r, dr->tin, red->par, dr->tout, dr->twork);
-  for (i = 0; i < d; i++) {
-    if (!isfinite(dr->tout[i]))
-      return dm_err_set(e, DM_ESINGULAR, "mu^T A is not finite (singular locked inertia)");
-    a[i] = dr->tout[i];
-  }
+  if (dm_routh_muA(dr->red, x, a, dr->tin, dr->tout, dr->twork))
+    return dm_err_set(e, DM_ESINGULAR, "mu^T A is not finite (singular locked inertia)");
   return DM_OK;
 }
 

@@ -16,23 +16,12 @@
 
 /* {==== programs ========================================================= */
 
+/* par: the parameter nodes of every program (original, then mu) */
 static int prog_compile(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *sp, dm_rprog *p,
                         size_t nout, const dm_expr *out, size_t nin, const dm_expr *in,
-                        dm_err *e)
+                        const dm_expr *par, dm_err *e)
 {
-  dm_expr par[64 + DM_ROUTH_RMAX];
-  dm_expr *pp = par;
-  int st;
-  size_t i;
-  if (red->np > sizeof par / sizeof par[0] && (pp = malloc(red->np * sizeof *pp)) == NULL)
-    return dm_err_set(e, DM_ENOMEM, "out of memory");
-  for (i = 0; i < red->npar; i++)
-    pp[i] = sp->par[i];
-  for (i = 0; i < red->r; i++)
-    pp[red->npar + i] = red->ex.mu[i];
-  st = dm_tape_compile(ctx, nout, out, nin, in, red->np, pp, &p->tape, e);
-  if (pp != par)
-    free(pp);
+  int st = dm_tape_compile(ctx, nout, out, nin, in, red->np, par, &p->tape, e);
   if (st != DM_OK)
     return st;
   p->nin = nin;
@@ -63,11 +52,124 @@ static void prog_free(dm_rprog *p)
 
 void dm_routh_release_progs(dm_routh *red)
 {
-  dm_rprog *ps[] = {&red->inertia, &red->conn, &red->connd, &red->gyro_r, &red->gyro_j,
-                    &red->thd, &red->info};
+  dm_rprog *ps[] = {&red->inertia, &red->conn, &red->connd, &red->gyro_r, &red->thd, &red->info};
   size_t i;
   for (i = 0; i < sizeof ps / sizeof ps[0]; i++)
     prog_free(ps[i]);
+  dm_bundle_free(&red->stage_r);
+  dm_bundle_free(&red->stage_j);
+}
+
+/* {==== RSPRK stage programs ============================================= */
+
+/* How each array of a stage is stored (dm_rstage_arr order). */
+static const unsigned stage_kind[DM_RS_NARR] = {
+  DM_BLK_VEC, DM_BLK_VEC, DM_BLK_SYM, DM_BLK_FULL, DM_BLK_SYM,      /* Lq Lv Lvv Lvq Lqq */
+  DM_BLK_VEC, DM_BLK_FULL, DM_BLK_FULL,                             /* F Fq Fv */
+  DM_BLK_VEC, DM_BLK_FULL, DM_BLK_FULL, DM_BLK_VEC, DM_BLK_VEC,     /* muA K B kv ib */
+  DM_BLK_FULL, DM_BLK_FULL                                          /* dkv dib */
+};
+
+/* One stage program: the arrays k with from[k] != NULL, whose rewritten
+ * outputs start at from[k] (symmetric ones as upper triangles), in
+ * dm_rstage_arr order; out: room for all the outputs. */
+static int compile_stage(dm_bundle *p, const dm_bundle_src *src, const dm_expr *const *from,
+                         size_t s, dm_expr *out, dm_err *e)
+{
+  dm_block blk[DM_RS_NARR];
+  dm_expr *o = out;
+  size_t nb = 0, k;
+  for (k = 0; k < DM_RS_NARR; k++) {
+    unsigned kind = stage_kind[k];
+    size_t len = kind == DM_BLK_VEC ? s : kind == DM_BLK_FULL ? s * s : s * (s + 1) / 2;
+    if (from[k] == NULL)
+      continue;
+    blk[nb++] = (dm_block){(unsigned)k, kind, s, 1, 0};
+    memcpy(o, from[k], len * sizeof *o);
+    o += len;
+  }
+  return dm_bundle_compile(p, src, (size_t)(o - out), out, 2 * s, blk, nb, 1, e);
+}
+
+/* The programs of an RSPRK stage, one per request kind (gradient: stage_r;
+ * with second derivatives: stage_j), each one tape, and native code, for
+ * every array of a stage (dm_rstage_arr).  Each group of outputs is
+ * rewritten as its own program rewrites it -- R^mu's derivatives as the
+ * compiled reduced system (dm_lagrangian_outputs), the force as its force
+ * (dm_lagrangian_force_outputs), the connection terms as gyro_r would for
+ * the gradient kind and as a program of all of them for the full kind --
+ * and the union compiled without rewriting: every value is bit for bit the
+ * one of the separate programs, the nodes the groups share (I, I^{-1}, A
+ * and their derivatives) are computed once, and one call fills a stage. */
+static int compile_stages(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *sp,
+                          const dm_expr *in, const dm_expr *par, const dm_expr *K,
+                          const dm_expr *kv, const dm_expr *ib, const dm_expr *dkv,
+                          const dm_expr *dib, dm_err *e)
+{
+  const dm_routh_exprs *x = &red->ex;
+  size_t s = red->s, ss = s * s, tri = s * (s + 1) / 2, nR = 1 + 2 * s + 2 * tri + ss;
+  size_t nF = red->has_force ? s + 2 * ss : 0, nG = red->has_gyro ? 3 * s + 4 * ss : 0;
+  dm_expr *R = malloc((2 * nR + nF + 3 * s + nG + nR + nF + nG) * sizeof *R);
+  dm_expr *Rw = R + nR, *F = Rw + nR, *Gr = F + nF, *Gj = Gr + 3 * s, *out = Gj + nG;
+  dm_bundle_src src = {ctx, in, s, red->np, par, NULL, red->par, sp->native};
+  int st;
+  if (R == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  st = dm_lagrangian_outputs(ctx, x->R, s, in, R, Rw, e);
+  if (st == DM_OK && nF)
+    st = dm_lagrangian_force_outputs(ctx, s, x->force, in, F, e);
+  if (st == DM_OK && nG) {
+    memcpy(Gr, x->muA, s * sizeof *Gr);
+    memcpy(Gr + s, kv, s * sizeof *Gr);
+    memcpy(Gr + 2 * s, ib, s * sizeof *Gr);
+    memcpy(Gj, x->muA, s * sizeof *Gj);
+    memcpy(Gj + s, K, ss * sizeof *Gj);
+    memcpy(Gj + s + ss, x->B, ss * sizeof *Gj);
+    memcpy(Gj + s + 2 * ss, kv, s * sizeof *Gj);
+    memcpy(Gj + 2 * s + 2 * ss, ib, s * sizeof *Gj);
+    memcpy(Gj + 3 * s + 2 * ss, dkv, ss * sizeof *Gj);
+    memcpy(Gj + 3 * s + 3 * ss, dib, ss * sizeof *Gj);
+    if ((st = dm_tape_optimize(ctx, 3 * s, Gr, Gr, e)) == DM_OK)
+      st = dm_tape_optimize(ctx, nG, Gj, Gj, e);
+  }
+  if (st == DM_OK) {         /* gradient: Lq, Lv, F, muA, kv, ib */
+    const dm_expr *from[DM_RS_NARR] = {Rw + 1, Rw + 1 + s};
+    if (nF)
+      from[DM_RS_F] = F;
+    if (nG) {
+      from[DM_RS_MUA] = Gr;
+      from[DM_RS_KV] = Gr + s;
+      from[DM_RS_IB] = Gr + 2 * s;
+    }
+    st = compile_stage(&red->stage_r, &src, from, s, out, e);
+  }
+  if (st == DM_OK) {         /* everything */
+    const dm_expr *from[DM_RS_NARR] = {Rw + 1, Rw + 1 + s, Rw + 1 + 2 * s, Rw + 1 + 2 * s + tri,
+                                       Rw + 1 + 2 * s + tri + ss};
+    if (nF) {
+      from[DM_RS_F] = F;
+      from[DM_RS_FQ] = F + s;
+      from[DM_RS_FV] = F + s + ss;
+    }
+    if (nG) {
+      from[DM_RS_MUA] = Gj;
+      from[DM_RS_K] = Gj + s;
+      from[DM_RS_B] = Gj + s + ss;
+      from[DM_RS_KV] = Gj + s + 2 * ss;
+      from[DM_RS_IB] = Gj + 2 * s + 2 * ss;
+      from[DM_RS_DKV] = Gj + 3 * s + 2 * ss;
+      from[DM_RS_DIB] = Gj + 3 * s + 3 * ss;
+    }
+    st = compile_stage(&red->stage_j, &src, from, s, out, e);
+  }
+  free(R);
+  if (st == DM_OK) {
+    if (red->stage_r.nregs > red->nwork)
+      red->nwork = red->stage_r.nregs;
+    if (red->stage_j.nregs > red->nwork)
+      red->nwork = red->stage_j.nregs;
+  }
+  return st;
 }
 
 /* {==== forwarding callbacks of the public reduced system ================ */
@@ -96,19 +198,10 @@ static int constr_forward(void *data, const double *q, const double *par, unsign
 /* {==== building ========================================================= */
 
 static int compile_system(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *sp, dm_expr L,
-                          const char *suffix, dm_system *sys, dm_err *e)
+                          const dm_expr *par, const char *suffix, dm_system *sys, dm_err *e)
 {
   dm_lagrangian_spec ls;
-  dm_expr *par = malloc(red->np * sizeof *par);
   char name[512];
-  int st;
-  size_t i;
-  if (par == NULL)
-    return dm_err_set(e, DM_ENOMEM, "out of memory");
-  for (i = 0; i < red->npar; i++)
-    par[i] = sp->par[i];
-  for (i = 0; i < red->r; i++)
-    par[red->npar + i] = red->ex.mu[i];
   snprintf(name, sizeof name, "%s%s", red->name, suffix);
   memset(&ls, 0, sizeof ls);
   ls.name = name;
@@ -125,9 +218,7 @@ static int compile_system(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *
   ls.m = red->m;
   ls.constraints = red->ex.constraints;
   ls.native = sp->native;
-  st = dm_lagrangian_compile(ctx, &ls, sys, e);
-  free(par);
-  return st;
+  return dm_lagrangian_compile(ctx, &ls, sys, e);
 }
 
 static int compile_full(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_system *sys, dm_err *e)
@@ -158,53 +249,50 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
 {
   const dm_routh_exprs *x = &red->ex;
   size_t r = red->r, s = red->s, ss = s * s, nmax;
-  size_t ninfo = 2 * r * r + r * s + r + s + 2 * ss + r + 5;
-  dm_expr *in = NULL, *out = NULL;
+  size_t ninfo = 2 * r * r + r * s + r + s + 2 * ss + r + 5, i;
+  dm_expr *in = NULL, *out = NULL, *par = NULL;
   int st;
-  nmax = ninfo > 3 * s + 4 * ss ? ninfo : 3 * s + 4 * ss;
+  nmax = ninfo > 3 * s ? ninfo : 3 * s;
   if (r + r * s + s > nmax)
     nmax = r + r * s + s;
   if (r * s + r * ss > nmax)
     nmax = r * s + r * ss;
   in = malloc(2 * s * sizeof *in);
   out = malloc(nmax * sizeof *out);
-  if (in == NULL || out == NULL) {
+  par = malloc(red->np * sizeof *par);
+  if (in == NULL || out == NULL || par == NULL) {
     st = dm_err_set(e, DM_ENOMEM, "out of memory");
     goto done;
   }
   memcpy(in, x->x, s * sizeof *in);
   memcpy(in + s, x->xdot, s * sizeof *in);
+  for (i = 0; i < red->npar; i++)
+    par[i] = sp->par[i];
+  for (i = 0; i < red->r; i++)
+    par[red->npar + i] = red->ex.mu[i];
   if ((st = compile_full(ctx, sp, &red->fsys, e)) != DM_OK ||
-      (st = compile_system(ctx, red, sp, x->R, "", &red->rsys, e)) != DM_OK ||
-      (st = compile_system(ctx, red, sp, x->Rc, " (classical Routhian)", &red->csys, e)) != DM_OK)
+      (st = compile_system(ctx, red, sp, x->R, par, "", &red->rsys, e)) != DM_OK ||
+      (st = compile_system(ctx, red, sp, x->Rc, par, " (classical Routhian)", &red->csys, e)) != DM_OK)
     goto done;
-  if ((st = prog_compile(ctx, red, sp, &red->inertia, r * r, x->I, s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->inertia, r * r, x->I, s, in, par, e)) != DM_OK)
     goto done;
   memcpy(out, x->Iinv_mu, r * sizeof *out);
   memcpy(out + r, x->A, r * s * sizeof *out);
   memcpy(out + r + r * s, x->muA, s * sizeof *out);
-  if ((st = prog_compile(ctx, red, sp, &red->conn, r + r * s + s, out, s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->conn, r + r * s + s, out, s, in, par, e)) != DM_OK)
     goto done;
   memcpy(out, Dw, r * s * sizeof *out);
   memcpy(out + r * s, DA, r * ss * sizeof *out);
-  if ((st = prog_compile(ctx, red, sp, &red->connd, r * s + r * ss, out, s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->connd, r * s + r * ss, out, s, in, par, e)) != DM_OK)
     goto done;
   memcpy(out, x->muA, s * sizeof *out);
   memcpy(out + s, kv, s * sizeof *out);
   memcpy(out + 2 * s, ib, s * sizeof *out);
-  if ((st = prog_compile(ctx, red, sp, &red->gyro_r, 3 * s, out, 2 * s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->gyro_r, 3 * s, out, 2 * s, in, par, e)) != DM_OK)
     goto done;
-  /* gyro_j: muA, K, B, kv, ib, dkv, dib */
-  memcpy(out, x->muA, s * sizeof *out);
-  memcpy(out + s, K, ss * sizeof *out);
-  memcpy(out + s + ss, x->B, ss * sizeof *out);
-  memcpy(out + s + 2 * ss, kv, s * sizeof *out);
-  memcpy(out + 2 * s + 2 * ss, ib, s * sizeof *out);
-  memcpy(out + 3 * s + 2 * ss, dkv, ss * sizeof *out);
-  memcpy(out + 3 * s + 3 * ss, dib, ss * sizeof *out);
-  if ((st = prog_compile(ctx, red, sp, &red->gyro_j, 3 * s + 4 * ss, out, 2 * s, in, e)) != DM_OK)
+  if ((st = compile_stages(ctx, red, sp, in, par, K, kv, ib, dkv, dib, e)) != DM_OK)
     goto done;
-  if ((st = prog_compile(ctx, red, sp, &red->thd, r, x->thetadot, 2 * s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->thd, r, x->thetadot, 2 * s, in, par, e)) != DM_OK)
     goto done;
   /* info: I, Iinv, A, Iinv_mu, muA, Mt, B, thetadot, detI, V, Vmu, R, Rc */
   {
@@ -219,7 +307,7 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
     memcpy(o, x->thetadot, r * sizeof *o); o += r;
     *o++ = x->detI; *o++ = x->V; *o++ = x->Vmu; *o++ = x->R; *o++ = x->Rc;
   }
-  if ((st = prog_compile(ctx, red, sp, &red->info, ninfo, out, 2 * s, in, e)) != DM_OK)
+  if ((st = prog_compile(ctx, red, sp, &red->info, ninfo, out, 2 * s, in, par, e)) != DM_OK)
     goto done;
   /* one parameter array for every system: a change through any of them
    * (e.g. a Lua params proxy on the public system) is seen by all */
@@ -247,6 +335,7 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
 done:
   free(in);
   free(out);
+  free(par);
   return st;
 }
 
@@ -424,6 +513,42 @@ int dm_routh_vanishes(dm_routh *red, dm_expr_ctx *ctx, dm_expr e)
   free(vars);
   free(vals);
   return ok;
+}
+
+int dm_routh_muA(const dm_routh *red, const double *x, double *muA, double *tin, double *tout,
+                 double *work)
+{
+  size_t s = red->s, i;
+  int bad = 0;
+  for (i = 0; i < s; i++) {
+    tin[i] = x[i];
+    tin[s + i] = 0.0;
+  }
+  dm_rprog_run(&red->gyro_r, tin, red->par, tout, work);
+  for (i = 0; i < s; i++) {
+    bad |= !isfinite(tout[i]);
+    muA[i] = tout[i];
+  }
+  return bad;
+}
+
+int dm_routh_muA_K(const dm_routh *red, const double *x, double *muA, double *K, double *tin,
+                   double *work)
+{
+  size_t s = red->s, i;
+  const double *in[2] = {x, tin + s};
+  double *o[DM_RS_NARR] = {NULL};
+  if (!red->has_gyro) {
+    memset(muA, 0, s * sizeof *muA);
+    memset(K, 0, s * s * sizeof *K);
+    return 0;
+  }
+  for (i = 0; i < s; i++)
+    tin[s + i] = 0.0;
+  o[DM_RS_MUA] = muA;
+  o[DM_RS_K] = K;
+  return dm_bundle_run(&red->stage_j, in, s, red->par, o, (1u << DM_RS_MUA) | (1u << DM_RS_K),
+                       work);
 }
 
 /* {==== small numerical helpers ========================================== */

@@ -4,6 +4,7 @@
 #define DM_ROUTH_IMPL_H
 
 #include "routh.h"
+#include "core/bundle.h"
 #include "core/newton.h"
 #include "core/tape.h"
 
@@ -23,6 +24,20 @@ static inline void dm_rprog_run(const dm_rprog *p, const double *in, const doubl
   else
     dm_tape_eval(p->tape, in, par, out, work);
 }
+
+/* The arrays an RSPRK stage program writes (bundle.h: output blocks, in
+ * this order), at a stage point (x, xdot): the derivatives of R^mu (Lq =
+ * dR/dx, Lv = dR/dxdot, Lvv, Lvq = d2R/dxdot dx, Lqq), the reduced force
+ * and its Jacobians, the connection terms muA, K = d muA/dx, B, kv = K xdot,
+ * ib = i_xdot B and their x-Jacobians dkv, dib.  The gradient program
+ * (stage_r) writes LQ, LV, F, MUA, KV, IB; the full one (stage_j) all;
+ * force and connection arrays only when the system has them. */
+enum dm_rstage_arr {
+  DM_RS_LQ, DM_RS_LV, DM_RS_LVV, DM_RS_LVQ, DM_RS_LQQ,
+  DM_RS_F, DM_RS_FQ, DM_RS_FV,
+  DM_RS_MUA, DM_RS_K, DM_RS_B, DM_RS_KV, DM_RS_IB, DM_RS_DKV, DM_RS_DIB,
+  DM_RS_NARR
+};
 
 /* Small dense LU with partial pivoting on a row-major N x N matrix, in
  * place (dm_smalllu_factor of src/core/smalllu.h; this struct holds the
@@ -56,7 +71,8 @@ struct dm_routh {
   dm_rprog conn;                   /* x -> Iinv_mu (r), A (r*s), muA (s) */
   dm_rprog connd;                  /* x -> D Iinv_mu (r*s), D A (r*s*s: [a][i][k] = dA_ai/dx_k) */
   dm_rprog gyro_r;                 /* (x, xd) -> muA, kv, ib */
-  dm_rprog gyro_j;                 /* (x, xd) -> muA, K, B, kv, ib, dkv/dx, dib/dx */
+  dm_bundle stage_r, stage_j;      /* (x, xd) -> the arrays of an RSPRK stage
+                                      (dm_rstage_arr): gradient / all */
   dm_rprog thd;                    /* (x, xd) -> thetadot (r) */
   dm_rprog info;                   /* (x, xd) -> everything of dm_routh_vals */
   size_t nwork;                    /* max tape work over the programs */
@@ -69,12 +85,23 @@ struct dm_routh {
 /* routh_compile.c: compile the systems and programs from the derived nodes
  * (red->ex) and the internal ones: K = d muA/dx (s*s), kv = K xdot, ib =
  * i_xdot B (s each), their x-Jacobians dkv, dib (s*s), Dw = d(I^{-1} mu)/dx
- * (r*s), DA (r*s*s). */
+ * (r*s), DA (r*s*s).  red->nwork covers the tapes of every program and
+ * stage bundle. */
 int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec *sp,
                            const dm_expr *K, const dm_expr *kv, const dm_expr *ib,
                            const dm_expr *dkv, const dm_expr *dib, const dm_expr *Dw,
                            const dm_expr *DA, dm_err *e);
 void dm_routh_release_progs(dm_routh *red);
+/* muA(x) (the connection term at zero velocity) from gyro_r; 1 when it is
+ * not finite (muA then holds the values), else 0.  tin: 2 s, tout:
+ * gyro_r.nout, work: red->nwork doubles. */
+int dm_routh_muA(const dm_routh *red, const double *x, double *muA, double *tin, double *tout,
+                 double *work);
+/* muA(x) and K(x) = d muA/dx (s x s) from stage_j (zeros without a
+ * connection term); 1 when an output of stage_j at (x, 0) is not finite
+ * (muA, K then unspecified).  tin: 2 s, work: red->nwork doubles. */
+int dm_routh_muA_K(const dm_routh *red, const double *x, double *muA, double *K, double *tin,
+                   double *work);
 int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
                          unsigned what, dm_lag_out *out, void *work);
 

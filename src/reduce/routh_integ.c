@@ -41,16 +41,8 @@ static const char *const routh_options[] = {"stages", "h", "tol", "maxiter", "si
 /* muA(x) with the tape of gyro_r at zero velocity */
 static int muA_at(rinteg *R, const double *x, double *a, dm_err *e)
 {
-  const dm_routh *red = R->red;
-  size_t d = red->s, i;
-  memcpy(R->tin, x, d * sizeof(double));
-  memset(R->tin + d, 0, d * sizeof(double));
-  dm_rprog_run(&red->gyro_r, R->tin, red->par, R->tout, R->twork);
-  for (i = 0; i < d; i++) {
-    if (!isfinite(R->tout[i]))
-      return dm_err_set(e, DM_EDOM, "mu^T A is not finite at this point");
-    a[i] = R->tout[i];
-  }
+  if (dm_routh_muA(R->red, x, a, R->tin, R->tout, R->twork))
+    return dm_err_set(e, DM_EDOM, "mu^T A is not finite at this point");
   return DM_OK;
 }
 
@@ -96,7 +88,7 @@ static void rinteg_free(dm_integrator *I)
 static int alloc_buffers(rinteg *R)
 {
   const dm_routh *red = R->red;
-  size_t d = red->s, nout = red->gyro_j.nout;
+  size_t d = red->s, nout = red->gyro_r.nout;
   R->x0c = calloc(7 * d + 2 * d + nout + red->nwork + red->r * red->r + 8, sizeof(double));
   if (R->x0c == NULL)
     return DM_ENOMEM;
@@ -275,27 +267,21 @@ static int classical_jacobian(dm_integrator *I, rinteg *R, double h, const doubl
 {
   const dm_routh *red = R->red;
   size_t d = red->s, N = 2 * d, i, j, k;
-  double *K0 = malloc((2 * d * d + N * N + 2 * d) * sizeof(double)), *K1, *Dc, *x1, *y0;
-  int st;
+  double *K0 = malloc((2 * d * d + N * N + 3 * d) * sizeof(double)), *K1, *Dc, *x1, *y0, *a;
+  int st = DM_OK;
   if (K0 == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
   K1 = K0 + d * d;
   Dc = K1 + d * d;
   x1 = Dc + N * N;
   y0 = x1 + d;
+  a = y0 + d;
   (void)I;
-  st = DM_OK;
-#define KAT(x, K)                                                           \
-  do {                                                                      \
-    memcpy(R->tin, x, d * sizeof(double));                                  \
-    memset(R->tin + d, 0, d * sizeof(double));                              \
-    dm_rprog_run(&red->gyro_j, R->tin, red->par, R->tout, R->twork);        \
-    memcpy(K, R->tout + d, d * d * sizeof(double));                         \
-  } while (0)
-  KAT(x0, K0);
+  if (dm_routh_muA_K(red, x0, a, K0, R->tin, R->twork))
+    st = dm_err_set(e, DM_EDOM, "mu^T A is not finite at this point");
   for (i = 0; i < d; i++)
-    y0[i] = s0[i] + R->tout[i];
-  if ((st = dm_integrator_jacobian(R->inner, h, x0, y0, Dc, e)) == DM_OK) {
+    y0[i] = s0[i] + a[i];
+  if (st == DM_OK && (st = dm_integrator_jacobian(R->inner, h, x0, y0, Dc, e)) == DM_OK) {
     double *yy = malloc(d * sizeof(double));
     if (yy == NULL)
       st = dm_err_set(e, DM_ENOMEM, "out of memory");
@@ -303,8 +289,9 @@ static int classical_jacobian(dm_integrator *I, rinteg *R, double h, const doubl
       st = dm_integrator_step(R->inner, h, x0, y0, x1, yy, e);
     free(yy);
   }
+  if (st == DM_OK && dm_routh_muA_K(red, x1, a, K1, R->tin, R->twork))
+    st = dm_err_set(e, DM_EDOM, "mu^T A is not finite at this point");
   if (st == DM_OK) {
-    KAT(x1, K1);
     /* right: columns of the x0 block get + Dc[:, d + k] K0[k][j] */
     for (i = 0; i < N; i++)
       for (j = 0; j < d; j++) {
@@ -328,7 +315,6 @@ static int classical_jacobian(dm_integrator *I, rinteg *R, double h, const doubl
       for (j = 0; j < N; j++)
         DPhi[(d + i) * N + j] = Dc[i * N + j];
   }
-#undef KAT
   R->last_valid = 0;
   free(K0);
   return st;

@@ -7,18 +7,21 @@
  *   x1 = x0 + h sum_j b_j Xd_j
  *   s1 = s0 + h sum_j b_j Sd_j + [h sum_j b_j K_j Xd_j - (muA(x1) - muA(x0))]
  * with K = d(mu^T A)/dx, (K Xd)_i = (mu dA/dx Xd)_i and (i_v beta)_c =
- * sum_d v_d B_dc, each evaluated from its own compiled program (not through
- * the classical Routhian: the momentum-shift equivalence is a test).
+ * sum_d v_d B_dc, each term derived and rewritten on its own (not through
+ * the classical Routhian: the momentum-shift equivalence is a test), all of
+ * a stage computed by one compiled program per request kind (gradient /
+ * with second derivatives: routh_compile.c, red->stage_r / stage_j).
  * Unknowns are the stage velocities; residual r_i = dR/dxdot(X_i, Xd_i) - S_i.
  * Newton uses the exact Jacobian
  *   dr_i/dXd_k = d_ik Rvv_i + h a_ik (Rvx_i + K_i) - h at_ik E_k - h^2 sum_j at_ij a_jk D_j,
  *   E_k = Rxv_k - B_k^T + Fv_k + K_k,  D_j = Rxx_j - d(i beta)/dx_j + Fx_j + d(K Xd)/dx_j,
  * with the engine's stopping rule (src/core/newton.h: scaled update <= tol,
  * or round-off stall once below 1e-10) and, as prk_engine.c, simplified
- * Newton reusing the factored exact Jacobian while updates contract tenfold.  The group increment of
- * the step (Hamiltonian-side reconstruction) is h sum_j b_j Thetadot_j,
- * Thetadot_j = I(X_j)^{-1} mu - A(X_j) Xd_j.  The step Jacobian comes from
- * the implicit function theorem on the converged stage equations. */
+ * Newton reusing the factored exact Jacobian while updates contract
+ * tenfold.  The group increment of the step (Hamiltonian-side
+ * reconstruction) is h sum_j b_j Thetadot_j, Thetadot_j = I(X_j)^{-1} mu -
+ * A(X_j) Xd_j.  The step Jacobian comes from the implicit function theorem
+ * on the converged stage equations. */
 #include <config.h>
 #include "rsprk_impl.h"
 #include "core/integrators/prk_kernels.h"
@@ -164,8 +167,8 @@ int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, 
   }
   P->N = Sd + (m ? P->nK * m + m : 0);
   nsm = d + m;
-  nout = red->gyro_j.nout > red->info.nout ? red->gyro_j.nout : red->info.nout;
-  tot = P->N * P->N + 2 * P->N + P->N * 2 * d + 8 * Sd + 11 * S * dd + S + 2 * d + 4 * dd
+  nout = red->gyro_r.nout > red->info.nout ? red->gyro_r.nout : red->info.nout;
+  tot = P->N * P->N + 2 * P->N + P->N * 2 * d + 8 * Sd + 11 * S * dd + S + 2 * d + 2 * dd
         + (S + 2) * (m + m * d + m * dd) + 6 * d + P->r + Sd + P->N + 2 * d + S * S + 2 * d
         + nsm * nsm + nsm + 2 * d + nout + red->nwork + red->r * red->r + 8;
   P->Jm = calloc(tot, sizeof(double));
@@ -184,7 +187,7 @@ int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, 
   TAKE(P->Fv, S * dd); TAKE(P->gK, S * dd); TAKE(P->gB, S * dd); TAKE(P->gdkv, S * dd);
   TAKE(P->gdib, S * dd); TAKE(P->D, S * dd); TAKE(P->E, S * dd);
   TAKE(P->Lval, S);
-  TAKE(P->a0, d); TAKE(P->a1, d); TAKE(P->K0, dd); TAKE(P->K1, dd); TAKE(P->B0, dd); TAKE(P->B1, dd);
+  TAKE(P->a0, d); TAKE(P->a1, d); TAKE(P->K0, dd); TAKE(P->K1, dd);
   TAKE(P->g, (S + 2) * m); TAKE(P->G, (S + 2) * m * d); TAKE(P->Hc, (S + 2) * m * dd);
   TAKE(P->q1w, d); TAKE(P->p1w, d); TAKE(P->v1w, d); TAKE(P->dq, d); TAKE(P->dp, d);
   TAKE(P->tmp, d); TAKE(P->thd, P->r);
@@ -193,6 +196,24 @@ int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, 
   TAKE(P->small, nsm * nsm + nsm);
   TAKE(P->tin, 2 * d); TAKE(P->tout, nout); TAKE(P->twork, red->nwork + red->r * red->r + 8);
 #undef TAKE
+  for (i = 0; i < S; i++) {
+    double **o = P->sout[i];
+    o[DM_RS_LQ] = P->Lq + i * d;
+    o[DM_RS_LV] = P->Lv + i * d;
+    o[DM_RS_LVV] = P->Lvv + i * dd;
+    o[DM_RS_LVQ] = P->Lvq + i * dd;
+    o[DM_RS_LQQ] = P->Lqq + i * dd;
+    o[DM_RS_F] = P->F + i * d;
+    o[DM_RS_FQ] = P->Fq + i * dd;
+    o[DM_RS_FV] = P->Fv + i * dd;
+    o[DM_RS_MUA] = P->ga + i * d;
+    o[DM_RS_K] = P->gK + i * dd;
+    o[DM_RS_B] = P->gB + i * dd;
+    o[DM_RS_KV] = P->gkv + i * d;
+    o[DM_RS_IB] = P->gib + i * d;
+    o[DM_RS_DKV] = P->gdkv + i * dd;
+    o[DM_RS_DIB] = P->gdib + i * dd;
+  }
   P->distinct_nodes = 1;
   for (i = 0; i < S; i++)
     for (j = 0; j < i; j++)
@@ -214,63 +235,23 @@ static int cb_fail(dm_rsprk *P, int st, const char *what, const double *x, dm_er
                     dm_rfmt_vec(bx, sizeof bx, x, P->d));
 }
 
-/* muA, kv, ib (and K, B, dkv, dib when jac) at (x, v) into the stage-i slots */
-static int eval_gyro(dm_rsprk *P, size_t i, const double *x, const double *v, int jac, dm_err *e)
+/* muA (and K = d muA/dx when K != NULL) at a node point x (velocity 0) */
+static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, dm_err *e)
 {
   const dm_routh *red = P->red;
-  size_t d = P->d, dd = P->dd;
-  const dm_rprog *pg = jac ? &red->gyro_j : &red->gyro_r;
-  double *o = P->tout;
-  dm_vcopy(P->tin, x, d);
-  dm_vcopy(P->tin + d, v, d);
-  dm_rprog_run(pg, P->tin, red->par, o, P->twork);
-  if (!all_finite(o, pg->nout))
-    return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", x, e);
-  dm_vcopy(P->ga + i * d, o, d);
-  if (!jac) {
-    dm_vcopy(P->gkv + i * d, o + d, d);
-    dm_vcopy(P->gib + i * d, o + 2 * d, d);
-    return DM_OK;
-  }
-  dm_vcopy(P->gK + i * dd, o + d, dd);
-  dm_vcopy(P->gB + i * dd, o + d + dd, dd);
-  dm_vcopy(P->gkv + i * d, o + d + 2 * dd, d);
-  dm_vcopy(P->gib + i * d, o + 2 * d + 2 * dd, d);
-  dm_vcopy(P->gdkv + i * dd, o + 3 * d + 2 * dd, dd);
-  dm_vcopy(P->gdib + i * dd, o + 3 * d + 3 * dd, dd);
-  return DM_OK;
+  int bad = K ? dm_routh_muA_K(red, x, a, K, P->tin, P->twork)
+              : dm_routh_muA(red, x, a, P->tin, P->tout, P->twork);
+  return bad ? cb_fail(P, 1, "the connection mu^T A", x, e) : DM_OK;
 }
 
-/* muA and K = d muA/dx at a node point x (velocity 0) */
-static int eval_node(dm_rsprk *P, const double *x, double *a, double *K, double *B, dm_err *e)
-{
-  const dm_routh *red = P->red;
-  size_t d = P->d, dd = P->dd, k;
-  double *o = P->tout;
-  dm_vcopy(P->tin, x, d);
-  for (k = 0; k < d; k++)
-    P->tin[d + k] = 0.0;
-  dm_rprog_run(K ? &red->gyro_j : &red->gyro_r, P->tin, red->par, o, P->twork);
-  if (!all_finite(o, K ? red->gyro_j.nout : d))
-    return cb_fail(P, 1, "the connection mu^T A", x, e);
-  dm_vcopy(a, o, d);
-  if (K)
-    memcpy(K, o + d, dd * sizeof(double));
-  if (B)
-    memcpy(B, o + d + dd, dd * sizeof(double));
-  return DM_OK;
-}
-
-/* R^mu (no value: the step never needs it), the reduced force and the
- * connection terms at stage i; Sdot, and D, E when jac.  Terms that are
- * identically zero (no force, no gyroscopic part) are not added. */
-static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
+/* After a stage program met a NaN or Inf: the separate callbacks name the
+ * culprit (the Routhian, the reduced force, else the connection terms). */
+static int stage_fail(dm_rsprk *P, size_t i, int jac, dm_err *e)
 {
   const dm_system *sys = P->sys;
   const double *par = P->red->par;
   const size_t d = P->d, dd = P->dd;
-  size_t a, b;
-  double *Xi = P->Xs + i * d, *Vi = P->X + i * d;
+  const double *Xi = P->Xs + i * d, *Vi = P->X + i * d;
   dm_lag_out o = {0, P->Lq + i * d, P->Lv + i * d, P->Lvv + i * dd, P->Lvq + i * dd,
                   P->Lqq + i * dd};
   unsigned what = DM_LAG_Q | DM_LAG_V | (jac ? (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ) : 0u);
@@ -283,8 +264,22 @@ static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
     if (st != 0)
       return cb_fail(P, st, "the reduced force", Xi, e);
   }
-  if (P->gyro && (st = eval_gyro(P, i, Xi, Vi, jac, e)) != DM_OK)
-    return st;
+  return cb_fail(P, 1, "the connection (mu^T A and its derivatives)", Xi, e);
+}
+
+/* The derivatives of R^mu (no value: the step never needs it), the reduced
+ * force and the connection terms at stage i, by one call of a stage
+ * program; then Sdot, and D, E when jac.  Terms that are identically zero
+ * (no force, no gyroscopic part) are not added. */
+static int eval_stage(dm_rsprk *P, size_t i, int jac, dm_err *e)
+{
+  const dm_routh *red = P->red;
+  const size_t d = P->d, dd = P->dd;
+  size_t a, b;
+  const double *in[2] = {P->Xs + i * d, P->X + i * d};
+  if (dm_bundle_run(jac ? &red->stage_j : &red->stage_r, in, d, red->par, P->sout[i], ~0u,
+                    P->twork))
+    return stage_fail(P, i, jac, e);
   {
     const double *restrict Lq = P->Lq + i * d, *restrict gib = P->gib + i * d;
     const double *restrict F = P->F + i * d;
@@ -581,7 +576,7 @@ static int finish(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
     return dm_rsprk_constr_finish(P, h, x0, s0, P->q1w, P->p1w, e);
   dm_prk_kahan(d, x0, P->dq, P->cq, P->q1w);
   if (P->gyro) {
-    if ((st = eval_node(P, P->q1w, P->a1, NULL, NULL, e)) != DM_OK)
+    if ((st = eval_node(P, P->q1w, P->a1, NULL, e)) != DM_OK)
       return st;
     for (a = 0; a < d; a++)
       P->dp[a] -= P->a1[a] - P->a0[a];
@@ -630,7 +625,7 @@ int dm_rsprk_step(dm_rsprk *P, double h, const double *x0, const double *s0, dou
     if (cont)
       dm_vcopy(P->a0, P->a1, d);
     else
-      st = eval_node(P, x0, P->a0, NULL, NULL, e);
+      st = eval_node(P, x0, P->a0, NULL, e);
   }
   if (st == DM_OK)
     st = predict(P, h, x0, s0, cont, e);
@@ -682,8 +677,8 @@ int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0,
   memcpy(x1, DPhi, d * sizeof(double));
   memset(P->K0, 0, dd * sizeof(double));
   memset(P->K1, 0, dd * sizeof(double));
-  if (P->gyro && ((st = eval_node(P, x0, P->a0, P->K0, NULL, e)) != DM_OK
-                  || (st = eval_node(P, x1, P->a1, P->K1, NULL, e)) != DM_OK))
+  if (P->gyro && ((st = eval_node(P, x0, P->a0, P->K0, e)) != DM_OK
+                  || (st = eval_node(P, x1, P->a1, P->K1, e)) != DM_OK))
     return st;
   if ((st = assemble(P, h, x0, s0, 1, e)) != DM_OK)
     return st;

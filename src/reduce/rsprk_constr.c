@@ -123,14 +123,11 @@ int dm_rsprk_constr_finish(dm_rsprk *P, double h, const double *x0, const double
   dm_prk_constr_momentum(P->tab, d, m, P->nK, P->K, P->X, P->G, P->dp);
   dm_prk_kahan(d, x0, P->dq, P->cq, x1);
   if (P->gyro) {
-    double *o = P->tout;
-    memcpy(P->tin, x1, d * sizeof(double));
-    memset(P->tin + d, 0, d * sizeof(double));
-    dm_rprog_run(&red->gyro_r, P->tin, red->par, o, P->twork);
-    for (c = 0; c < d; c++) {
-      P->a1[c] = o[c];                 /* reused as muA(x0) by the next step */
-      P->dp[c] -= o[c] - P->a0[c];
-    }
+    /* muA(x1), reused as muA(x0) by the next step (not finite: s1 is, and
+     * the step fails on it) */
+    (void)dm_routh_muA(red, x1, P->a1, P->tin, P->tout, P->twork);
+    for (c = 0; c < d; c++)
+      P->dp[c] -= P->a1[c] - P->a0[c];
   }
   if ((st = constr(P, x1, DM_CONSTR_G | DM_CONSTR_DG, S + 1, e)) != DM_OK)
     return st;

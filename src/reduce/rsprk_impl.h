@@ -19,8 +19,10 @@ struct dm_rsprk {
   double *Jm, *R, *X, *rhs;      /* N*N, N, N, N*2d */
   double *Xs, *Lq, *Lv, *F, *Sdot, *ga, *gkv, *gib;                  /* S*d each */
   double *Lvv, *Lvq, *Lqq, *Fq, *Fv, *gK, *gB, *gdkv, *gdib, *D, *E;  /* S*d*d each */
+  double *sout[DM_TABLEAU_SMAX][DM_RS_NARR];  /* stage i's arrays in the stage
+                                                 programs' order (dm_rstage_arr) */
   double *Lval;                  /* S */
-  double *a0, *a1, *K0, *K1, *B0, *B1;  /* d, d, d*d x4 */
+  double *a0, *a1, *K0, *K1;     /* d, d, d*d, d*d */
   double *g, *G, *Hc;            /* constraint values at S + 2 points: stages, x0 (S), x1 (S+1) */
   double *q1w, *p1w, *v1w, *dq, *dp, *tmp;   /* d each */
   double *thd;                   /* r */

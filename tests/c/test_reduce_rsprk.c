@@ -8,7 +8,12 @@
  *  4. non-canonical symplecticity defect <= 1e-10 (and the canonical one is
  *     not small: the magnetic term matters);
  *  5. reconstruct() of a sampled reduced run, phase split, error path
- *     (singular inertia during a run keeps the partial trajectory). */
+ *     (singular inertia during a run keeps the partial trajectory);
+ *  6. the stage programs (white box, routh_impl.h): one call per stage gives
+ *     R^mu's derivatives and the reduced force bit for bit as the reduced
+ *     system's callbacks, muA, kv, ib as gyro_r, K, dkv, dib as differences
+ *     of muA, kv, ib, B = K^T - K; a stage leaving the domain of R^mu names
+ *     the Routhian. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>
@@ -16,6 +21,7 @@
 #include "core/status.h"
 #include "core/trajectory.h"
 #include "reduce/routh.h"
+#include "reduce/routh_impl.h"
 #include "reduce_systems.h"
 #include "tap.h"
 
@@ -343,6 +349,148 @@ static void singular_run(void)
   dm_expr_ctx_free(S.c);
 }
 
+/* The arrays of one stage-program call at (x, v), into buf */
+static int stage_call(const dm_routh *red, int jac, const double *x, const double *v, double *buf,
+                      double **o, double *work)
+{
+  const double *in[2] = {x, v};
+  size_t k;
+  for (k = 0; k < DM_RS_NARR; k++)
+    o[k] = buf + k * 16;
+  memset(buf, 0, DM_RS_NARR * 16 * sizeof *buf);
+  return dm_bundle_run(jac ? &red->stage_j : &red->stage_r, in, red->s, red->par, o, ~0u, work);
+}
+
+static int same(const double *a, const double *b, size_t n)
+{
+  return memcmp(a, b, n * sizeof *a) == 0;
+}
+
+static void stage_programs(void)
+{
+  static const double PF[6] = {1.3, 0.8, 1.1, 0.9, 9.81, 0.37};
+  const double x[3] = {0.61, 0.47, 0.29}, v[3] = {0.23, -0.41, 0.37}, dlt = 1e-6;
+  double *work = NULL, br[DM_RS_NARR * 16], bj[DM_RS_NARR * 16], bp[DM_RS_NARR * 16];
+  double bm[DM_RS_NARR * 16], *o[DM_RS_NARR], *oj[DM_RS_NARR], *op[DM_RS_NARR], *om[DM_RS_NARR];
+  double tin[6], tout[64], muA[3], Lq[3], Lv[3], Lvv[9], Lvq[9], Lqq[9], F[3], Fq[9], Fv[9];
+  int forced;
+  for (forced = 0; forced < 2; forced++) {
+    rsys S;
+    dm_routh *red = NULL;
+    dm_err e;
+    size_t cyc = 1, a, b;
+    double mu = 1.73, dK = 0, dB = 0, dkv = 0, dd = 0, dg = 0;
+    const dm_system *rs;
+    const char *tag = forced ? "forced dsp (tapes):" : "dsp (native when available):";
+    dm_lag_out lo = {0, Lq, Lv, Lvv, Lvq, Lqq};
+    int bad;
+    rs_dsp(&S, PF, forced);
+    /* native code (when a compiler works) for one, tapes for the other */
+    if (!tap_ok(rs_reduce_native(&S, 1, &cyc, &mu, forced ? DM_NATIVE_NEVER : DM_NATIVE_AUTO,
+                                 &red, &e) == DM_OK, "%s derive", tag)) {
+      tap_diag("%s", e.msg);
+      dm_expr_ctx_free(S.c);
+      continue;
+    }
+    rs = &red->rsys;
+    work = malloc((red->nwork + 8) * sizeof *work);
+    bad = stage_call(red, 0, x, v, br, o, work) | stage_call(red, 1, x, v, bj, oj, work);
+    rs->lagrangian(rs->data, x, v, red->par, DM_LAG_Q | DM_LAG_V, &lo, work);
+    tap_ok(!bad && same(o[DM_RS_LQ], Lq, 3) && same(o[DM_RS_LV], Lv, 3),
+           "%s gradient program: R_x, R_v bit for bit as the reduced system", tag);
+    rs->lagrangian(rs->data, x, v, red->par, DM_LAG_ALL, &lo, work);
+    tap_ok(same(oj[DM_RS_LQ], Lq, 3) && same(oj[DM_RS_LV], Lv, 3) && same(oj[DM_RS_LVV], Lvv, 9)
+           && same(oj[DM_RS_LVQ], Lvq, 9) && same(oj[DM_RS_LQQ], Lqq, 9),
+           "%s full program: R_x, R_v, R_vv, R_vx, R_xx bit for bit", tag);
+    if (forced) {
+      rs->force(rs->data, x, v, red->par, DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V, F, Fq, Fv, work);
+      tap_ok(same(o[DM_RS_F], F, 3) && same(oj[DM_RS_F], F, 3) && same(oj[DM_RS_FQ], Fq, 9)
+             && same(oj[DM_RS_FV], Fv, 9), "%s Fhat, Fhat_x, Fhat_v bit for bit as the "
+             "reduced force (%.4g %.4g %.4g)", tag, F[0], F[1], F[2]);
+    }
+    memcpy(tin, x, sizeof x);
+    memcpy(tin + 3, v, sizeof v);
+    dm_rprog_run(&red->gyro_r, tin, red->par, tout, work);
+    tap_ok(same(o[DM_RS_MUA], tout, 3) && same(o[DM_RS_KV], tout + 3, 3)
+           && same(o[DM_RS_IB], tout + 6, 3) && vdiff(oj[DM_RS_MUA], tout, 3) <= 4e-15
+           && vdiff(oj[DM_RS_KV], tout + 3, 3) <= 4e-15 && vdiff(oj[DM_RS_IB], tout + 6, 3) <= 4e-15,
+           "%s muA, kv, ib as gyro_r (gradient: bit for bit; full: %.2g)", tag,
+           fmax(vdiff(oj[DM_RS_KV], tout + 3, 3), vdiff(oj[DM_RS_IB], tout + 6, 3)));
+    /* derivatives in x by central differences of the gradient program */
+    for (b = 0; b < 3; b++) {
+      double xp[3] = {x[0], x[1], x[2]}, xm[3] = {x[0], x[1], x[2]};
+      xp[b] += dlt;
+      xm[b] -= dlt;
+      stage_call(red, 0, xp, v, bp, op, work);
+      stage_call(red, 0, xm, v, bm, om, work);
+      for (a = 0; a < 3; a++) {
+        dK = fmax(dK, fabs((op[DM_RS_MUA][a] - om[DM_RS_MUA][a]) / (2 * dlt) - oj[DM_RS_K][a * 3 + b]));
+        dkv = fmax(dkv, fabs((op[DM_RS_KV][a] - om[DM_RS_KV][a]) / (2 * dlt) - oj[DM_RS_DKV][a * 3 + b]));
+        dkv = fmax(dkv, fabs((op[DM_RS_IB][a] - om[DM_RS_IB][a]) / (2 * dlt) - oj[DM_RS_DIB][a * 3 + b]));
+        dB = fmax(dB, fabs(oj[DM_RS_B][a * 3 + b] - (oj[DM_RS_K][b * 3 + a] - oj[DM_RS_K][a * 3 + b])));
+      }
+    }
+    tap_ok(dK <= 1e-8 && dkv <= 1e-8 && dB <= 1e-15,
+           "%s K, dkv, dib against central differences (%.2g, %.2g), B = K^T - K (%.2g)",
+           tag, dK, dkv, dB);
+    /* the node helpers: muA and K at zero velocity */
+    {
+      double z[3] = {0, 0, 0}, K[9];
+      bad = dm_routh_muA_K(red, x, muA, K, tin, work);
+      stage_call(red, 1, x, z, bj, oj, work);
+      dd = vdiff(muA, oj[DM_RS_MUA], 3) + vdiff(K, oj[DM_RS_K], 9);
+      bad |= dm_routh_muA(red, x, muA, tin, tout, work);
+      dg = vdiff(muA, oj[DM_RS_MUA], 3);
+      tap_ok(!bad && dd == 0.0 && dg <= 4e-15 && fabs(muA[1]) > 0.1,
+             "%s muA(x) = %.6g %.6g %.6g and K(x) at zero velocity (full program: same bits; "
+             "gyro_r: %.2g)", tag, muA[0], muA[1], muA[2], dg);
+    }
+    /* outside the domain of R^mu (r1 > l1): the stage program reports it and
+     * the step names the Routhian */
+    {
+      const double xo[3] = {1.11, 0.47, 0.29};
+      int st;
+      double x1[3] = {1.0, 0.47, 0.29}, s1[3] = {6.0, 0.1, 0.1};
+      dm_integrator *I = NULL;
+      bad = stage_call(red, 0, xo, v, br, o, work);
+      dm_routh_integrator_new(red, "gauss", NULL, &I, NULL);
+      st = dm_integrator_step(I, 0.2, x1, s1, x1, s1, &e);     /* a stage at r1 > 1.1 */
+      tap_ok(bad == 1 && st == DM_EDOM && strstr(e.msg, "the Routhian is not finite") != NULL
+             && strstr(e.msg, "x = (1,") == NULL && x1[0] == 1.0,
+             "%s stage program outside the domain: non-finite reported, the step fails at a "
+             "stage point naming the Routhian: %s", tag, e.msg);
+      dm_integrator_free(I);
+    }
+    free(work);
+    dm_routh_free(red);
+    dm_expr_ctx_free(S.c);
+  }
+  /* J2 has no connection term (A = 0): zeros for muA and K, and the
+   * classical method's Jacobian (built on them) stays symplectic */
+  {
+    rsys S;
+    dm_routh *red = NULL;
+    dm_integrator *I = NULL;
+    size_t cyc = 1;
+    double mu = 0.93, xj[2] = {1.07, 0.21}, sj[2] = {0.13, -0.08}, K[4] = {1, 1, 1, 1};
+    double m2[2] = {1, 1}, def = 1;
+    int bad;
+    rs_j2(&S, 0.0123);
+    rs_reduce(&S, 1, &cyc, &mu, &red, NULL);
+    work = malloc((red->nwork + 8) * sizeof *work);
+    bad = dm_routh_muA_K(red, xj, m2, K, tin, work);
+    dm_routh_integrator_new(red, "classical", NULL, &I, NULL);
+    dm_routh_symplecticity_defect(I, 0.05, xj, sj, &def, NULL);
+    tap_ok(!bad && !red->has_gyro && vdiff(m2, K, 2) == 0.0 && vdiff(K, K + 2, 2) == 0.0
+           && K[0] == 0.0 && def <= 1e-10, "J2 (no connection term): muA = K = 0, classical "
+           "Jacobian defect %.2g", def);
+    dm_integrator_free(I);
+    free(work);
+    dm_routh_free(red);
+    dm_expr_ctx_free(S.c);
+  }
+}
+
 int main(void)
 {
   dm_gsl_init();
@@ -350,5 +498,6 @@ int main(void)
   orders_and_defect();
   reconstruct_and_phase();
   singular_run();
+  stage_programs();
   return tap_done();
 }
