@@ -2,31 +2,11 @@
 #include <config.h>
 #include "smalllu.h"
 #include "status.h"
+#include "vecmath.h"
 
 #include <float.h>
 #include <math.h>
 #include <gsl/gsl_linalg.h>
-
-/* max |a_i| over k entries, or NaN when an entry is NaN; no branch per
- * entry, two independent max chains (maxsd has a 4-cycle latency). */
-static double maxabs(const double *restrict a, size_t k)
-{
-  double m0 = 0.0, m1 = 0.0;
-  int nan = 0;
-  size_t i;
-  for (i = 0; i + 1 < k; i += 2) {
-    double t0 = fabs(a[i]), t1 = fabs(a[i + 1]);
-    m0 = t0 > m0 ? t0 : m0;
-    m1 = t1 > m1 ? t1 : m1;
-    nan |= (t0 != t0) | (t1 != t1);
-  }
-  if (i < k) {
-    double t0 = fabs(a[i]);
-    m0 = t0 > m0 ? t0 : m0;
-    nan |= t0 != t0;
-  }
-  return nan ? NAN : m0 > m1 ? m0 : m1;
-}
 
 /* Right-looking elimination (the classical kji loop), rows swapped whole so
  * that the interchanges can be applied to b up front; the diagonal keeps
@@ -36,7 +16,7 @@ static double maxabs(const double *restrict a, size_t k)
  * -O2 (GCC keeps the loops), so one generic copy. */
 static int factor_small(double *restrict a, size_t n, size_t *restrict perm)
 {
-  double amax = maxabs(a, n * n), tiny;
+  double amax = dm_norm_inf(a, n * n), tiny;
   size_t i, j, k;
   if (!(amax < HUGE_VAL))
     return DM_EDOM;
@@ -102,7 +82,7 @@ static int factor_gsl(double *a, size_t n, size_t *perm)
 {
   gsl_matrix_view A = gsl_matrix_view_array(a, n, n);
   gsl_permutation P = {n, perm};
-  double amax = maxabs(a, n * n), umin = HUGE_VAL;
+  double amax = dm_norm_inf(a, n * n), umin = HUGE_VAL;
   size_t i;
   int signum;
   if (!(amax < HUGE_VAL))

@@ -2,8 +2,8 @@
  * (not part of the public API; include only from src/core/integrators).
  *
  *  - checked callback evaluation (SUNDIALS statuses -> DM_* with messages),
- *  - the infinity norm of the Newton tests (stopping rule: src/core/newton.h,
- *    LU: src/core/smalllu.h),
+ *  - the helpers of the Newton tests (infinity norm: src/core/vecmath.h,
+ *    stopping rule: src/core/newton.h, LU: src/core/smalllu.h),
  *  - the Legendre-map workspace (velocity Newton, Hamiltonian vector field
  *    and its Jacobian, used by rk4 and gsl:*),
  *  - the implicit PRK engine used by midpoint/gauss/trapezoid/lobatto/prk
@@ -56,30 +56,6 @@ static inline int dm_eval_constr(const dm_system *sys, const double *q, unsigned
 /* "(x1, x2, ...)" into buf (at most 6 entries). */
 const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n);
 
-
-/* max |x_i|, NaN when some x_i is NaN (+-Inf gives Inf).  Inline and
- * without a branch per entry: it runs several times per Newton iteration on
- * vectors of a few entries, where a call to a loop with fmax or an early
- * return cost ~10% of a Gauss-2 step (perf).  Two max chains halve the
- * latency of the maxsd dependency. */
-static inline double dm_norm_inf(const double *x, size_t n)
-{
-  double m0 = 0.0, m1 = 0.0;
-  int nan = 0;
-  size_t i;
-  for (i = 0; i + 1 < n; i += 2) {
-    double a = fabs(x[i]), b = fabs(x[i + 1]);
-    m0 = a > m0 ? a : m0;
-    m1 = b > m1 ? b : m1;
-    nan |= (a != a) | (b != b);
-  }
-  if (i < n) {
-    double a = fabs(x[i]);
-    m0 = a > m0 ? a : m0;
-    nan |= a != a;
-  }
-  return nan ? NAN : m0 > m1 ? m0 : m1;
-}
 
 /* {==== Legendre map ===================================================== */
 

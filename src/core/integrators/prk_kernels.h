@@ -1,8 +1,9 @@
 /* prk_kernels.h -- pieces of the implicit PRK step shared by the core
  * engine (prk_engine.c, prk_constrained.c) and the reduced RSPRK engine of
  * src/reduce (rsprk.c, rsprk_constr.c), which solve the same stage
- * equations on different state: small inline helpers of the hot path,
- * the compensated update, the stage predictor, the constraint multipliers.
+ * equations on different state: the compensated update, the stage
+ * predictor, the constraint multipliers (and, through vecmath.h, the
+ * inline vector helpers of the hot path).
  * Everything works on arrays owned by the caller (row-major, stage-major:
  * stage i of an s x n array is row i); nothing allocates and nothing fails.
  */
@@ -10,47 +11,10 @@
 #define DM_PRK_KERNELS_H
 
 #include <stddef.h>
-#include <stdint.h>
-#include <string.h>
 #include "tableau.h"
+#include "vecmath.h"
 
-/* {==== inline helpers of the hot path =================================== */
-
-/* y = x, n doubles, as an inline loop: the copies of a step are a few
- * doubles each and a memcpy call costs more than the copy.  (No restrict:
- * GCC would turn the loop back into a memmove call.) */
-static inline void dm_vcopy(double *y, const double *x, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++)
-    y[i] = x[i];
-}
-
-/* x and y bitwise equal (memcmp semantics, inline). */
-static inline int dm_same(const double *x, const double *y, size_t n)
-{
-  size_t i;
-  for (i = 0; i < n; i++) {
-    uint64_t a, b;
-    memcpy(&a, x + i, sizeof a);
-    memcpy(&b, y + i, sizeof b);
-    if (a != b)
-      return 0;
-  }
-  return 1;
-}
-
-/* max(a, b), NaN when either is NaN (fmax drops NaNs and is a libm call
- * at -O2). */
-static inline double dm_max2(double a, double b)
-{
-  return a > b || a != a ? a : b;
-}
-
-static inline double dm_max3(double a, double b, double c)
-{
-  return dm_max2(dm_max2(a, b), c);
-}
+/* {==== compensated update =============================================== */
 
 /* out = x0 + dx with Kahan compensation: carry holds the rounding error of
  * the previous additions (zero at the start of a run) and is updated. */
