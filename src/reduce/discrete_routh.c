@@ -140,14 +140,13 @@ static int muA_at(dm_routh_dr *dr, const double *x, double *a, dm_err *e)
   return DM_OK;
 }
 
-/* Midpoint: psi (+ Dpsi), full two-point data p0, p1, Ld (+ d.. blocks). */
-static int lift_midpoint(dm_routh_dr *dr, double h, const double *x0, const double *x1, int deriv,
-                         dm_err *e)
+/* The midpoint formula psi = h I(xbar)^{-1} mu - A(xbar)(x1 - x0), with
+ * the connection data at xbar (and its derivatives when deriv). */
+static int psi_midpoint(dm_routh_dr *dr, double h, const double *x0, const double *x1, int deriv,
+                        dm_err *e)
 {
-  const dm_routh *red = dr->red;
-  size_t n = dr->n, r = dr->r, d = dr->d, a, i, k, c;
+  size_t r = dr->r, d = dr->d, a, i;
   double xb[64], *xbar = d <= 64 ? xb : dr->dx;
-  dm_lag_out o = {0, dr->Lq, dr->Lv, dr->Lvv, dr->Lvq, dr->Lqq};
   int st;
   for (i = 0; i < d; i++)
     xbar[i] = 0.5 * (x0[i] + x1[i]);
@@ -159,6 +158,19 @@ static int lift_midpoint(dm_routh_dr *dr, double h, const double *x0, const doub
       acc -= dr->A[a * d + i] * (x1[i] - x0[i]);
     dr->psi[a] = acc;
   }
+  return DM_OK;
+}
+
+/* Midpoint: psi (+ Dpsi), full two-point data p0, p1, Ld (+ d.. blocks). */
+static int lift_midpoint(dm_routh_dr *dr, double h, const double *x0, const double *x1, int deriv,
+                         dm_err *e)
+{
+  const dm_routh *red = dr->red;
+  size_t n = dr->n, r = dr->r, d = dr->d, a, i, k, c;
+  dm_lag_out o = {0, dr->Lq, dr->Lv, dr->Lvv, dr->Lvq, dr->Lqq};
+  int st;
+  if ((st = psi_midpoint(dr, h, x0, x1, deriv, e)) != DM_OK)
+    return st;
   if (deriv)      /* D1 psi = (h/2) Dw - 1/2 DA.dx + A, D2 psi = (h/2) Dw - 1/2 DA.dx - A */
     for (a = 0; a < r; a++)
       for (k = 0; k < d; k++) {
@@ -205,19 +217,10 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
   const double *mu = red->par + red->npar;
   size_t n = dr->n, r = dr->r, d = dr->d, a, b, i, it;
   double Jr[DM_ROUTH_RMAX * DM_ROUTH_RMAX], f[DM_ROUTH_RMAX], dn = HUGE_VAL;
-  double xb[64], *xbar = d <= 64 ? xb : dr->dx;
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
   int st, ok = 0;
-  for (i = 0; i < d; i++)
-    xbar[i] = 0.5 * (x0[i] + x1[i]);
-  if ((st = conn_at(dr, xbar, 0, e)) != DM_OK)
+  if ((st = psi_midpoint(dr, h, x0, x1, 0, e)) != DM_OK)
     return st;
-  for (a = 0; a < r; a++) {
-    double acc = h * dr->w[a];
-    for (i = 0; i < d; i++)
-      acc -= dr->A[a * d + i] * (x1[i] - x0[i]);
-    dr->psi[a] = acc;
-  }
   dm_routh_join(red, NULL, x0, dr->q0);
   for (it = 0; it < (size_t)dr->maxiter; it++) {
     double sc = 0.0;

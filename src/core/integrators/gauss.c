@@ -50,12 +50,9 @@ static int midpoint_dlegendre(dm_integrator *I, double h, const double *q0, cons
 {
   dm_prk *P = I->state;
   size_t n = P->n, a;
-  int st;
-  if (P->m)
-    return dm_err_set(e, DM_EUNSUP,
-                      "discrete Legendre transforms are not available for constrained systems");
-  if (h == 0.0)
-    return dm_err_set(e, DM_EINVAL, "discrete Legendre transform needs h != 0");
+  int st = dm_prk_dleg_check(P, h, e);
+  if (st != DM_OK)
+    return st;
   for (a = 0; a < n; a++) {
     P->Q[a] = 0.5 * (q0[a] + q1[a]);
     P->X[a] = (q1[a] - q0[a]) / h;

@@ -561,17 +561,24 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
   return DM_OK;
 }
 
-int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
-                     double *p0, double *p1, double *Ld, dm_integ_stats *stt, dm_err *e)
+int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e)
 {
-  size_t n = P->n, s = P->s, sn = P->sn, i, a;
-  const double *b = P->tab->b;
-  int st;
   if (P->m)
     return dm_err_set(e, DM_EUNSUP,
                       "discrete Legendre transforms are not available for constrained systems");
   if (h == 0.0)
     return dm_err_set(e, DM_EINVAL, "discrete Legendre transform needs h != 0");
+  return DM_OK;
+}
+
+int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
+                     double *p0, double *p1, double *Ld, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, a;
+  const double *b = P->tab->b;
+  int st = dm_prk_dleg_check(P, h, e);
+  if (st != DM_OK)
+    return st;
   for (i = 0; i < s; i++)
     for (a = 0; a < n; a++)
       P->X[i * n + a] = (q1[a] - q0[a]) / h;

@@ -60,6 +60,9 @@ struct dm_prk {
 /* prk_engine.c */
 int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e);
 int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e);
+/* DM_OK, or the error of a discrete Legendre transform that cannot be
+ * taken (constrained system, h = 0). */
+int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e);
 
 /* prk_constrained.c */
 int dm_prk_constr_layout(dm_prk *P, dm_err *e);

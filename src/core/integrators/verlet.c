@@ -83,6 +83,20 @@ static inline void minv_mul(const dm_prk *P, const double *x, double *y)
   }
 }
 
+/* u = M^{-1} ph with the half-step momentum ph = base - G0^T mu0 */
+static void shake_velocity(const dm_prk *P, const double *base, const double *G0,
+                           const double *mu, double *ph, double *u)
+{
+  size_t n = P->n, m = P->m, a, c;
+  for (c = 0; c < n; c++) {
+    double acc = base[c];
+    for (a = 0; a < m; a++)
+      acc -= G0[a * n + c] * mu[a];
+    ph[c] = acc;
+  }
+  minv_mul(P, ph, u);
+}
+
 /* SHAKE: mu0 with g(q0 + h M^{-1}(base - G0^T mu0)) = 0; leaves u = M^{-1} p_half
  * in X[0..n) and mu0 in X[2n..2n+m). */
 static int shake(dm_prk *P, double h, const double *q0, const double *base, const double *G0,
@@ -94,13 +108,7 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
   int it, st;
   for (it = 1; it <= P->maxiter; it++) {
-    for (c = 0; c < n; c++) {
-      double acc = base[c];
-      for (a = 0; a < m; a++)
-        acc -= G0[a * n + c] * mu[a];
-      ph[c] = acc;
-    }
-    minv_mul(P, ph, u);
+    shake_velocity(P, base, G0, mu, ph, u);
     for (c = 0; c < n; c++)
       qq[c] = q0[c] + h * u[c];
     if ((st = dm_eval_constr(P->sys, qq, DM_CONSTR_G | DM_CONSTR_DG, gq, Gq, NULL, P->work, e)) != DM_OK)
@@ -138,13 +146,7 @@ static int shake(dm_prk *P, double h, const double *q0, const double *base, cons
   if (it > P->maxiter)
     return dm_err_set(e, DM_ENOCONV, "SHAKE iteration for the position constraints did not converge: "
                       "relative update %.3g > tol %.3g (h = %g)", d, P->tol, h);
-  for (c = 0; c < n; c++) {
-    double acc = base[c];
-    for (a = 0; a < m; a++)
-      acc -= G0[a * n + c] * mu[a];
-    ph[c] = acc;
-  }
-  minv_mul(P, ph, u);
+  shake_velocity(P, base, G0, mu, ph, u);
   return DM_OK;
 }
 
