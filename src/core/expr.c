@@ -303,25 +303,9 @@ dm_expr dm_expr_param(dm_expr_ctx *ctx, const char *name)
  * =================================================================== */
 
 #define K(x) dm_expr_const(ctx, (x))
+#define isc dm_expr__isc
+#define check2 dm_expr__check2
 
-static int isc(const dm_expr_ctx *ctx, dm_expr e, double *v)
-{
-  if (ctx->node[e].op != DM_EXPR_CONST)
-    return 0;
-  *v = ctx->cval[ctx->node[e].a];
-  return 1;
-}
-
-static int check2(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (a == DM_EXPR_NONE || b == DM_EXPR_NONE)
-    return 0;
-  if (!dm_expr__valid(ctx, a) || !dm_expr__valid(ctx, b)) {
-    dm_expr__fail(ctx, DM_EINVAL, "expression: invalid node handle");
-    return 0;
-  }
-  return 1;
-}
 
 /* x^n exactly as the tape and the native code compute it. */
 double dm_expr__powi_value(double x, int n);

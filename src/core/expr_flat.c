@@ -32,14 +32,6 @@ static dm_expr oom(dm_expr_ctx *ctx)
   return dm_expr__fail(ctx, DM_ENOMEM, "expression: out of memory");
 }
 
-int dm_expr__isc(const dm_expr_ctx *ctx, dm_expr e, double *v)
-{
-  if (ctx->node[e].op != DM_EXPR_CONST)
-    return 0;
-  *v = ctx->cval[ctx->node[e].a];
-  return 1;
-}
-
 int dm_expr__sumlike(const dm_expr_ctx *ctx, dm_expr e)
 {
   while (ctx->node[e].op == NEG)

@@ -159,7 +159,27 @@ int dm_expr__flatten_prod(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int64_t ex,
                           int src, int merge);
 dm_nel *dm_expr__new_el(dm_expr_ctx *ctx, dm_flat *f);
 int dm_expr__grow(void *pp, size_t *cap, size_t need, size_t size);
-int dm_expr__isc(const dm_expr_ctx *ctx, dm_expr e, double *v);
+/* 1 and *v = its value when e is a constant node. */
+static inline int dm_expr__isc(const dm_expr_ctx *ctx, dm_expr e, double *v)
+{
+  if (ctx->node[e].op != DM_EXPR_CONST)
+    return 0;
+  *v = ctx->cval[ctx->node[e].a];
+  return 1;
+}
+/* 1 when a and b are valid operands of a constructor; 0 for DM_EXPR_NONE
+ * (an earlier failure, already recorded), or 0 after recording
+ * DM_EINVAL for an invalid handle. */
+static inline int dm_expr__check2(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
+{
+  if (a == DM_EXPR_NONE || b == DM_EXPR_NONE)
+    return 0;
+  if (!dm_expr__valid(ctx, a) || !dm_expr__valid(ctx, b)) {
+    dm_expr__fail(ctx, DM_EINVAL, "expression: invalid node handle");
+    return 0;
+  }
+  return 1;
+}
 /* e is a sum (ADD, SUB, or negations of one). */
 int dm_expr__sumlike(const dm_expr_ctx *ctx, dm_expr e);
 /* Element hashes and the hash of a multiset from their sum; the normal

@@ -52,6 +52,7 @@
 #define hfin dm_expr__hfin
 #define probe dm_expr__probe
 #define reg dm_expr__reg
+#define check2 dm_expr__check2
 
 enum { ADD = DM_EXPR_ADD, SUB = DM_EXPR_SUB, MUL = DM_EXPR_MUL,
        DIV = DM_EXPR_DIV, NEG = DM_EXPR_NEG, POWI = DM_EXPR_POWI };
@@ -449,17 +450,6 @@ static dm_expr norm_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
 /* {==================================================================
  * the constructors
  * =================================================================== */
-
-static int check2(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
-{
-  if (a == DM_EXPR_NONE || b == DM_EXPR_NONE)
-    return 0;
-  if (!dm_expr__valid(ctx, a) || !dm_expr__valid(ctx, b)) {
-    dm_expr__fail(ctx, DM_EINVAL, "expression: invalid node handle");
-    return 0;
-  }
-  return 1;
-}
 
 dm_expr dm_expr_add(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {

@@ -29,6 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define grow dm_expr__grow
+
 enum { K_OTHER = 0, K_SUM = 1, K_PROD = 2 };
 enum { ADD = DM_EXPR_ADD, SUB = DM_EXPR_SUB, MUL = DM_EXPR_MUL,
        DIV = DM_EXPR_DIV, NEG = DM_EXPR_NEG, POWI = DM_EXPR_POWI };
@@ -88,22 +90,6 @@ typedef struct opt {
   dm_expr one;
   int nomem;
 } opt;
-
-static int grow(void *pp, size_t *cap, size_t need, size_t size)
-{
-  if (need <= *cap)
-    return 0;
-  size_t c = *cap ? *cap : 64;
-  while (c < need)
-    c *= 2;
-  void **p = pp;
-  void *q = realloc(*p, c * size);
-  if (q == NULL)
-    return -1;
-  *p = q;
-  *cap = c;
-  return 0;
-}
 
 static long pos(const opt *o, dm_expr x)
 {
