@@ -223,7 +223,6 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
     return st;
   dm_routh_join(red, NULL, x0, dr->q0);
   for (it = 0; it < (size_t)dr->maxiter; it++) {
-    double sc = 0.0;
     dm_routh_join(red, dr->psi, x1, dr->q1);
     st = dm_gld_solve(dr->g, h, dr->q0, dr->q1, dr->p0, dr->p1, dr->Ld, 1, dr->d00, dr->d01,
                       dr->d10, dr->d11, 1, e);
@@ -231,7 +230,6 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
       return st;
     for (a = 0; a < r; a++) {
       f[a] = dr->p1[red->cyc[a]] - mu[a];
-      sc = fmax(sc, fabs(mu[a]) + fabs(dr->p1[red->cyc[a]]));
       for (b = 0; b < r; b++)
         Jr[a * r + b] = dr->d11[red->cyc[a] * n + red->cyc[b]];
     }
@@ -246,7 +244,6 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
       ok = 1;
       break;
     }
-    (void)sc;
   }
   if (!ok)
     return dm_err_set(e, DM_ENOCONV, "psi_mu: Newton on J_d = mu did not converge (update %.3g)", dn);
