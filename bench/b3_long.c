@@ -22,7 +22,7 @@
 
 #include <gsl/gsl_errno.h>
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "core/status.h"
 #include "peers/benchutil.h"
 #include "peers/gsl_peer.h"

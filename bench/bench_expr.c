@@ -15,11 +15,11 @@
 #include <string.h>
 #include <time.h>
 
-#include "core/expr.h"
-#include "core/lagrangian.h"
+#include "expr/expr.h"
+#include "expr/lagrangian.h"
 #include "core/status.h"
 #include "core/system.h"
-#include "core/tape.h"
+#include "expr/tape.h"
 
 dm_expr tx_parse(dm_expr_ctx *ctx, const char *s);
 

@@ -38,7 +38,7 @@
 
 #include "lua/dmlua.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 
 /* CPU time of this thread: the machine may be shared, and time spent
  * descheduled is not the code's cost. */

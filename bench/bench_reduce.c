@@ -21,7 +21,7 @@
 #include <time.h>
 
 #include "core/status.h"
-#include "core/lagrangian.h"
+#include "expr/lagrangian.h"
 #include "reduce/routh.h"
 #include "reduce_systems.h"
 

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "traced.h"
-#include "core/expr.h"
+#include "expr/expr.h"
 
 const char *const bt_names[BT_NSYS] = {
   "Kepler (2-D)", "J2 Cartesian", "J2 cylindrical", "spherical pendulum",

@@ -9,7 +9,7 @@
 #ifndef BENCH_TRACED_H
 #define BENCH_TRACED_H
 
-#include "core/lagrangian.h"
+#include "expr/lagrangian.h"
 #include "core/status.h"
 #include "core/system.h"
 

@@ -17,7 +17,7 @@
 #include <lauxlib.h>
 #include <lua.h>
 
-#include "repl.h"
+#include "app/repl.h"
 
 #ifdef HAVE_READLINE
 #include <readline/readline.h>

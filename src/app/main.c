@@ -19,7 +19,7 @@
 
 #include "core/interrupt.h"
 #include "lua/dmlua.h"
-#include "repl.h"
+#include "app/repl.h"
 
 static const char *progname = DM_PROGNAME;
 

@@ -29,7 +29,7 @@
 #include <readline/readline.h>
 #endif
 
-#include "repl.h"
+#include "app/repl.h"
 
 #define PROMPT1 "dm> "
 #define PROMPT2 ".. "

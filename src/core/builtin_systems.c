@@ -2,7 +2,7 @@
  * Callbacks follow system.h: fill the requested outputs, return 0, or 1
  * (recoverable) at a singular point (|q| = 0). */
 #include <config.h>
-#include "builtin_systems.h"
+#include "core/builtin_systems.h"
 
 #include <math.h>
 #include <stdlib.h>

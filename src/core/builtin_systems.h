@@ -11,8 +11,8 @@
 #ifndef DM_BUILTIN_SYSTEMS_H
 #define DM_BUILTIN_SYSTEMS_H
 
-#include "status.h"
-#include "system.h"
+#include "core/status.h"
+#include "core/system.h"
 
 /* L = 1/2 v^2 - 1/2 omega^2 q^2 (n = 1; par: omega). Separable. */
 int dm_builtin_harmonic(dm_system *s, double omega, dm_err *e);

@@ -1,5 +1,5 @@
 /* newton.h -- the stopping rule of the Newton iterations in the implicit
- * integrators (src/core/integrators: PRK stages, SHAKE, velocity and
+ * integrators (src/integrators: PRK stages, SHAKE, velocity and
  * momentum-projection solves; src/reduce: RSPRK stages, discrete Routh
  * equations, Galerkin discrete Lagrangian).
  *

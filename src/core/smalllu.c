@@ -1,8 +1,8 @@
 /* smalllu.c -- small dense LU with partial pivoting (see smalllu.h). */
 #include <config.h>
-#include "smalllu.h"
-#include "status.h"
-#include "vecmath.h"
+#include "core/smalllu.h"
+#include "core/status.h"
+#include "core/vecmath.h"
 
 #include <float.h>
 #include <math.h>

@@ -1,6 +1,6 @@
 /* status.c -- status names, error records, GSL status mapping. */
 #include <config.h>
-#include "status.h"
+#include "core/status.h"
 
 #include <stdarg.h>
 #include <stdio.h>

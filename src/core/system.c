@@ -1,6 +1,6 @@
 /* system.c -- helpers common to every dm_system. */
 #include <config.h>
-#include "system.h"
+#include "core/system.h"
 
 #include <string.h>
 

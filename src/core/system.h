@@ -4,7 +4,7 @@
  * and its first and second derivatives, and optionally a generalized force
  * F(q, v; par) and holonomic constraints g(q; par) = 0.  The callbacks are
  * implemented either by tapes compiled from a traced Lua function (the
- * expression engine, src/core/lagrangian.c) or by hand-written C (built-in
+ * expression engine, src/expr/lagrangian.c) or by hand-written C (built-in
  * systems, src/core/builtin_systems.c).  Integrators never know which.
  *
  * Conventions

@@ -1,7 +1,7 @@
 /* tableau.c -- Gauss, Lobatto IIIA-IIIB and user PRK coefficient tables.
  * See tableau.h for the formulas and the ownership rules. */
 #include <config.h>
-#include "tableau.h"
+#include "core/tableau.h"
 
 #include <float.h>
 #include <math.h>

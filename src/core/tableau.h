@@ -21,7 +21,7 @@
 #define DM_TABLEAU_H
 
 #include <stddef.h>
-#include "status.h"
+#include "core/status.h"
 
 /* Largest number of stages the generators accept. */
 #define DM_TABLEAU_SMAX 20

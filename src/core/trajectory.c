@@ -1,14 +1,14 @@
 /* trajectory.c -- columnar storage of a run: columns, samples, derived
  * columns, slicing, metadata.  The CSV files are in trajectory_csv.c. */
 #include <config.h>
-#include "trajectory.h"
+#include "core/trajectory.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "interrupt.h"
+#include "core/interrupt.h"
 
 typedef struct column {
   char *name;

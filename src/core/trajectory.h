@@ -52,7 +52,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
-#include "status.h"
+#include "core/status.h"
 
 typedef struct dm_traj dm_traj;
 

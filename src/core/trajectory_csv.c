@@ -3,7 +3,7 @@
  * both in a private "C" numeric locale selected with uselocale() for this
  * thread only, so the user's LC_NUMERIC (a decimal comma) never matters. */
 #include <config.h>
-#include "trajectory.h"
+#include "core/trajectory.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -15,7 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "interrupt.h"
+#include "core/interrupt.h"
 
 #define MAGIC "# dmech trajectory "
 #define FORMAT_VERSION 1

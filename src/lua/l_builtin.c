@@ -5,7 +5,7 @@
 #include <config.h>
 #include <string.h>
 
-#include "l_system.h"
+#include "lua/l_system.h"
 #include "core/builtin_systems.h"
 
 /* Optional table of options at argument 1 (nil or absent: defaults);

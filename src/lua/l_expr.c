@@ -7,8 +7,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "l_expr.h"
-#include "core/native.h"
+#include "lua/l_expr.h"
+#include "expr/native.h"
 
 #define CTX_KEY "dmech.exprctx"
 #define SYMVEC_MT "dmech.symvec"

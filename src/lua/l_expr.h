@@ -12,8 +12,8 @@
 #ifndef DM_L_EXPR_H
 #define DM_L_EXPR_H
 
-#include "dmlua.h"
-#include "core/expr.h"
+#include "lua/dmlua.h"
+#include "expr/expr.h"
 
 #define DM_EXPR_MT "dmech.expr"
 

@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "l_expr.h"
+#include "lua/l_expr.h"
 
 /* {======================================================================
  * lists of expressions and of variables

@@ -6,9 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_expr.h"
-#include "core/native.h"
-#include "core/tape.h"
+#include "lua/l_expr.h"
+#include "expr/native.h"
+#include "expr/tape.h"
 #include "core/interrupt.h"
 
 #define FN_MT "dmech.fn"

@@ -12,7 +12,7 @@
 #ifndef DM_L_INTEG_H
 #define DM_L_INTEG_H
 
-#include "l_system.h"
+#include "lua/l_system.h"
 #include "core/tableau.h"
 
 #define DM_INTEG_MT "dmech.integrator"

@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "l_integ.h"
+#include "lua/l_integ.h"
 
 static int tab_gc(lua_State *L)
 {

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "l_integ.h"
+#include "lua/l_integ.h"
 
 #define TABBOX_MT "dmech.tableaubox"
 

@@ -18,7 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "l_integ.h"
+#include "lua/l_integ.h"
 #include "core/interrupt.h"
 #include "core/trajectory.h"
 

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_integ.h"
+#include "lua/l_integ.h"
 
 /* {======================================================================
  * life cycle

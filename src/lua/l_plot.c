@@ -20,7 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 #include "plot/gnuplot.h"
 
 #define GP_MT "dmech.gnuplot"

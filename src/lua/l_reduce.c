@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_reduce.h"
+#include "lua/l_reduce.h"
 
 static void routh_sys_free(dm_system *s)
 {

@@ -9,9 +9,9 @@
 #ifndef DM_L_REDUCE_H
 #define DM_L_REDUCE_H
 
-#include "dmlua.h"
-#include "l_expr.h"
-#include "l_system.h"
+#include "lua/dmlua.h"
+#include "lua/l_expr.h"
+#include "lua/l_system.h"
 #include "reduce/routh.h"
 #include "core/trajectory.h"
 

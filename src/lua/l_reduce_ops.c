@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_reduce.h"
+#include "lua/l_reduce.h"
 
 #define IBOX_MT "dmech.routh.ibox"
 

@@ -8,10 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_system.h"
-#include "l_expr.h"
-#include "core/lagrangian.h"
-#include "core/native.h"
+#include "lua/l_system.h"
+#include "lua/l_expr.h"
+#include "expr/lagrangian.h"
+#include "expr/native.h"
 
 
 /* {======================================================================

@@ -24,10 +24,10 @@
 #ifndef DM_L_SYSTEM_H
 #define DM_L_SYSTEM_H
 
-#include "dmlua.h"
-#include "core/expr.h"
+#include "lua/dmlua.h"
+#include "expr/expr.h"
 #include "core/system.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 
 #define DM_SYSTEM_MT "dmech.system"
 

@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "l_system.h"
-#include "l_expr.h"
+#include "lua/l_system.h"
+#include "lua/l_expr.h"
 
 #define PARAMS_MT "dmech.params"
 

@@ -12,8 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dmlua.h"
-#include "l_traj.h"
+#include "lua/dmlua.h"
+#include "lua/l_traj.h"
 #include "core/trajectory.h"
 
 #define COLS_MT "dmech.trajectory.columns"

@@ -4,7 +4,7 @@
 #ifndef DM_L_TRAJ_H
 #define DM_L_TRAJ_H
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 /* The metadata value at arg as a string pushed on the stack: strings as they
  * are, floats in shortest round-trip form, integers and booleans by

@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dmlua.h"
-#include "l_traj.h"
+#include "lua/dmlua.h"
+#include "lua/l_traj.h"
 #include "core/trajectory.h"
 
 /* A metadata value from Lua: strings as they are, numbers round-tripping. */

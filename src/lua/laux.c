@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e)
 {

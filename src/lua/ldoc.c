@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 static void pushregtable(lua_State *L, const char *key, const char *mode)
 {

@@ -2,7 +2,7 @@
  * A new binding module adds one line to `openers`. */
 #include <config.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 typedef void (*dm_opener)(lua_State *L);
 

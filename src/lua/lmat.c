@@ -14,7 +14,7 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_permutation.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 /* {======================================================================
  * construction and checking

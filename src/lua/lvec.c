@@ -12,7 +12,7 @@
 
 #include <gsl/gsl_blas.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 /* {======================================================================
  * construction and checking

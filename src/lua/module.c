@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dmlua.h"
+#include "lua/dmlua.h"
 
 /* Prepend "<dir>/?.lua" for every directory we search to package.path, once. */
 static void setpath(lua_State *L)

@@ -22,7 +22,7 @@
 #include <unistd.h>
 
 #include "core/interrupt.h"
-#include "gp_private.h"
+#include "plot/gp_private.h"
 
 static size_t fmt_number(char *p, double x)
 {

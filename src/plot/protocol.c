@@ -20,7 +20,7 @@
 #include <unistd.h>
 
 #include "core/interrupt.h"
-#include "gp_private.h"
+#include "plot/gp_private.h"
 
 #define GP_DEFAULT_TIMEOUT 30.0
 

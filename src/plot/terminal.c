@@ -18,7 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "gp_private.h"
+#include "plot/gp_private.h"
 
 /* {==== the choice ========================================================== */
 

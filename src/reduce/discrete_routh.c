@@ -16,7 +16,7 @@
  * F+ = D2 Lhat - Ahat_2; Newton on x1 with the exact Jacobian
  * -dF-/dx1 = -(dp0_x/dx1 + dp0_x/dtheta1 D2 psi). */
 #include <config.h>
-#include "routh_impl.h"
+#include "reduce/routh_impl.h"
 
 #include <float.h>
 #include <math.h>

@@ -10,7 +10,7 @@
  * discrete Routh equations (discrete_routh.c) build psi_mu, the reduced
  * discrete Lagrangian and its one-forms on it. */
 #include <config.h>
-#include "routh_impl.h"
+#include "reduce/routh_impl.h"
 
 #include <float.h>
 #include <math.h>

@@ -6,7 +6,7 @@
  * psi_mu(x_k, x_{k+1}) on the Lagrangian side), and the split of the group
  * advance over a closed shape loop into dynamic and geometric phases. */
 #include <config.h>
-#include "routh_impl.h"
+#include "reduce/routh_impl.h"
 #include "core/interrupt.h"
 
 #include <math.h>

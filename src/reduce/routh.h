@@ -80,13 +80,13 @@
 
 #include <stddef.h>
 
-#include "core/expr.h"
-#include "core/native.h"
+#include "expr/expr.h"
+#include "expr/native.h"
 #include "core/status.h"
 #include "core/system.h"
 #include "core/tableau.h"
 #include "core/trajectory.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 
 #define DM_ROUTH_RMAX 3
 

@@ -5,8 +5,8 @@
  * family can find the connection data), accessors, mu and parameter
  * updates, evaluation, and small numerical helpers. */
 #include <config.h>
-#include "routh_impl.h"
-#include "core/lagrangian.h"
+#include "reduce/routh_impl.h"
+#include "expr/lagrangian.h"
 #include "core/smalllu.h"
 
 #include <float.h>

@@ -8,7 +8,7 @@
  * object an expression that prints, differentiates and compiles, and r is
  * the dimension of an abelian symmetry group, in practice 1 or 2. */
 #include <config.h>
-#include "routh_impl.h"
+#include "reduce/routh_impl.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -3,10 +3,10 @@
 #ifndef DM_ROUTH_IMPL_H
 #define DM_ROUTH_IMPL_H
 
-#include "routh.h"
-#include "core/bundle.h"
+#include "reduce/routh.h"
+#include "expr/bundle.h"
 #include "core/newton.h"
-#include "core/tape.h"
+#include "expr/tape.h"
 
 /* A compiled bundle of outputs: tape, and native code when available. */
 typedef struct dm_rprog {

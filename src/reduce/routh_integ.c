@@ -1,5 +1,5 @@
 /* routh_integ.c -- the "routh" integrator family: one dm_integrator_type
- * (registered in src/core/integrators/registry.c) whose variant selects the
+ * (registered in src/integrators/registry.c) whose variant selects the
  * reduced method on the reduced system of a dm_routh (routh.h):
  *   routh:gauss | midpoint | lobatto | trapezoid | prk   RSPRK (rsprk.c)
  *   routh:dr[:midpoint | :gauss | :lobatto]              discrete Routh equations
@@ -9,7 +9,7 @@
  * State (q, p) = (x, s) for all of them.  The group coordinate is
  * accumulated per step with compensated summation (reconstruction). */
 #include <config.h>
-#include "rsprk_impl.h"
+#include "reduce/rsprk_impl.h"
 #include "core/interrupt.h"
 
 #include <float.h>

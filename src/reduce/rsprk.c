@@ -23,8 +23,8 @@
  * A(X_j) Xd_j.  The step Jacobian comes from the implicit function theorem
  * on the converged stage equations. */
 #include <config.h>
-#include "rsprk_impl.h"
-#include "core/integrators/prk_kernels.h"
+#include "reduce/rsprk_impl.h"
+#include "integrators/prk_kernels.h"
 #include "core/interrupt.h"
 
 #include <float.h>

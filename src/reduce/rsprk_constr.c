@@ -1,6 +1,6 @@
 /* rsprk_constr.c -- holonomic constraints ghat(y) = 0 on the preshape space
  * in the RSPRK step (thesis §2.8, Theorems 2.14 / 2.17; spec routh.md §6),
- * with the multiplier layout of src/core/integrators/prk_constrained.c and
+ * with the multiplier layout of src/integrators/prk_constrained.c and
  * its kernels (prk_kernels.h: stages, residual/Jacobian terms, impulses):
  * unknowns (Xd_i, Lt_k for the interior stages k of a Lobatto-type tableau,
  * mu0 on the initial momentum); equations
@@ -12,8 +12,8 @@
  * in s equals the projection of the full p_x on J = mu (the connection
  * term muA(x1) is fixed), so the reduction commutes with RATTLE. */
 #include <config.h>
-#include "rsprk_impl.h"
-#include "core/integrators/prk_kernels.h"
+#include "reduce/rsprk_impl.h"
+#include "integrators/prk_kernels.h"
 
 #include <math.h>
 #include <string.h>

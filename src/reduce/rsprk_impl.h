@@ -3,7 +3,7 @@
 #ifndef DM_RSPRK_IMPL_H
 #define DM_RSPRK_IMPL_H
 
-#include "routh_impl.h"
+#include "reduce/routh_impl.h"
 
 struct dm_rsprk {
   dm_routh *red;

@@ -10,7 +10,7 @@
 #define DM_REDUCE_SYSTEMS_H
 
 #include <string.h>
-#include "core/expr.h"
+#include "expr/expr.h"
 #include "reduce/routh.h"
 
 typedef struct rsys {

@@ -9,7 +9,7 @@
 #include <string.h>
 #include "core/status.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "tap.h"
 
 static const double G = 9.81, L = 1.3;

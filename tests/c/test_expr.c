@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "core/expr.h"
+#include "expr/expr.h"
 #include "tap.h"
 
 dm_expr tx_parse(dm_expr_ctx *ctx, const char *s);

@@ -9,7 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "core/expr.h"
+#include "expr/expr.h"
 
 dm_expr tx_parse(dm_expr_ctx *ctx, const char *s);
 int tx_cstep(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,

@@ -7,7 +7,7 @@
 #include <string.h>
 #include "core/status.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "tap.h"
 
 static dm_integrator *comp(const dm_system *s, const char *scheme, const char *base, int expl)

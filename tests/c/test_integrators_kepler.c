@@ -8,7 +8,7 @@
 #include <string.h>
 #include "core/status.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "tap.h"
 
 static double energy(const double *q, const double *p)

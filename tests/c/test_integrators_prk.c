@@ -8,7 +8,7 @@
 #include <gsl/gsl_sf_elljac.h>
 #include "core/status.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "tap.h"
 
 static dm_integrator *make(const dm_system *s, const char *method, int stages, int expl)

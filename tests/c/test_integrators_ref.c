@@ -6,7 +6,7 @@
 #include "core/status.h"
 #include "core/builtin_systems.h"
 #include "core/tableau.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "integ_testsys.h"
 #include "tap.h"
 

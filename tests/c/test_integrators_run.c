@@ -8,7 +8,7 @@
 #include "core/status.h"
 #include "core/interrupt.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "integ_testsys.h"
 #include "tap.h"
 

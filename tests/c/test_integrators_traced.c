@@ -8,10 +8,10 @@
 #include <math.h>
 #include <string.h>
 #include "core/status.h"
-#include "core/expr.h"
-#include "core/lagrangian.h"
+#include "expr/expr.h"
+#include "expr/lagrangian.h"
 #include "core/builtin_systems.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "tap.h"
 
 typedef struct traced {

@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include "core/expr.h"
-#include "core/lagrangian.h"
+#include "expr/expr.h"
+#include "expr/lagrangian.h"
 #include "core/status.h"
 #include "core/system.h"
 #include "tap.h"

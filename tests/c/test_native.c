@@ -11,9 +11,9 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include "core/expr.h"
-#include "core/native.h"
-#include "core/tape.h"
+#include "expr/expr.h"
+#include "expr/native.h"
+#include "expr/tape.h"
 #include "tap.h"
 
 dm_expr tx_parse(dm_expr_ctx *ctx, const char *s);

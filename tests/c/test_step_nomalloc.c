@@ -21,11 +21,11 @@
 #include <gsl/gsl_vector.h>
 
 #include "core/status.h"
-#include "core/expr.h"
-#include "core/lagrangian.h"
+#include "expr/expr.h"
+#include "expr/lagrangian.h"
 #include "core/builtin_systems.h"
 #include "core/smalllu.h"
-#include "core/integrators/integrator.h"
+#include "integrators/integrator.h"
 #include "reduce/routh.h"
 #include "reduce_systems.h"
 #include "tap.h"

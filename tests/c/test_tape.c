@@ -6,8 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "core/expr.h"
-#include "core/tape.h"
+#include "expr/expr.h"
+#include "expr/tape.h"
 #include "tap.h"
 
 dm_expr tx_parse(dm_expr_ctx *ctx, const char *s);

@@ -1,0 +1,612 @@
+/* lagrangian.c -- derive and compile a Lagrangian system; the dm_system
+ * callbacks that run the tapes (or their native versions).  See
+ * lagrangian.h. */
+#include <config.h>
+#include "expr/lagrangian.h"
+#include "expr/bundle.h"
+#include "expr/tape.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
+typedef struct lag_data {
+  size_t n, m, npar;
+  char *name;
+  char **coords, **params;
+  double *par, *mass;
+  /* compiled bundles of outputs (bundle.h) */
+  dm_bundle grad, all;        /* L, Lq, Lv | + Lvv, Lvq, Lqq */
+  dm_bundle lq, qvqq;         /* separable L: Lq (of q alone) | Lq, Lv, Lqq */
+  const dm_bundle *sel[DM_LAG_ALL + 1];  /* the cheapest bundle for each request */
+  dm_bundle force, force_all; /* F | + Fq, Fv */
+  dm_bundle constr, constr_all;  /* g, G | + H */
+  dm_bundle massp;            /* Lvv (n*n) when constant in q and v */
+  int mass_possible;
+} lag_data;
+
+static void lag_free_data(lag_data *d)
+{
+  if (d == NULL)
+    return;
+  for (size_t i = 0; d->coords && i < d->n; i++)
+    free(d->coords[i]);
+  for (size_t i = 0; d->params && i < d->npar; i++)
+    free(d->params[i]);
+  free(d->coords);
+  free(d->params);
+  free(d->name);
+  free(d->par);
+  free(d->mass);
+  dm_bundle *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force, &d->force_all,
+                      &d->constr, &d->constr_all, &d->massp };
+  for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    dm_bundle_free(ps[i]);
+  free(d);
+}
+
+static void lag_free(dm_system *s)
+{
+  lag_free_data(s->data);
+  s->data = NULL;
+}
+
+/* Inputs are written straight into the tape's register file (its first
+ * registers are the inputs), so neither path copies them twice; the tape
+ * path of a callback is dm_bundle_tape_scatter. */
+static inline void copy(double *dst, const double *src, size_t k)
+{
+  for (size_t i = 0; i < k; i++)
+    dst[i] = src[i];
+}
+
+/* 1 if any of x[0..k) is NaN or infinite (independent tests, no serial
+ * chain: this runs after every evaluation). */
+static int nonfinite(const double *x, size_t k)
+{
+  int bad = 0;
+  for (size_t i = 0; i < k; i++)
+    bad |= !(fabs(x[i]) <= DBL_MAX);
+  return bad;
+}
+
+/* {==================================================================
+ * callbacks
+ * =================================================================== */
+
+/* The request mask is passed with L (whose storage is always there) and
+ * the arrays the bundle lacks (p->fill) set, so that a request of all the
+ * bundle has takes native code's direct path. */
+static int lag_eval(void *data, const double *q, const double *v,
+                    const double *par, unsigned what, dm_lag_out *out,
+                    void *work)
+{
+  const lag_data *d = data;
+  const size_t n = d->n;
+  const dm_bundle *p = d->sel[what & DM_LAG_ALL];
+  double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
+  if (p->scatter != NULL) {
+    const double *in[2] = { q, v };
+    return p->scatter(in, par, o, what | DM_LAG_L | p->fill);
+  }
+  double *w = work;
+  copy(w, q, n);
+  if (p->nin > n)
+    copy(w + n, v, n);
+  return dm_bundle_tape_scatter(p, w, par, o, what | DM_LAG_L | p->fill);
+}
+
+static int force_eval(void *data, const double *q, const double *v,
+                      const double *par, unsigned what, double *F, double *Fq,
+                      double *Fv, void *work)
+{
+  const lag_data *d = data;
+  const size_t n = d->n;
+  const dm_bundle *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  double *o[3] = { F, Fq, Fv };
+  if (p->scatter != NULL) {
+    const double *in[2] = { q, v };
+    return p->scatter(in, par, o, what);
+  }
+  double *w = work;
+  copy(w, q, n);
+  copy(w + n, v, n);
+  return dm_bundle_tape_scatter(p, w, par, o, what);
+}
+
+static int constr_eval(void *data, const double *q, const double *par,
+                       unsigned what, double *g, double *G, double *H,
+                       void *work)
+{
+  const lag_data *d = data;
+  const dm_bundle *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
+  double *o[3] = { g, G, H };
+  if (p->scatter != NULL) {
+    const double *in[1] = { q };
+    return p->scatter(in, par, o, what);
+  }
+  double *w = work;
+  copy(w, q, d->n);
+  return dm_bundle_tape_scatter(p, w, par, o, what);
+}
+
+/* {==================================================================
+ * building
+ * =================================================================== */
+
+typedef struct builder {
+  dm_expr_ctx *ctx;
+  const dm_lagrangian_spec *sp;
+  dm_expr *in;              /* q then v */
+  double *in0;              /* typical inputs, or NULL */
+  dm_err *err;
+} builder;
+
+static int ctx_fail(builder *b, const char *what)
+{
+  const dm_err *e = dm_expr_ctx_err(b->ctx);
+  return dm_err_set(b->err, e->status ? e->status : DM_EFAILED, "%s: %s",
+                    what, e->msg[0] ? e->msg : "cannot build the derivatives");
+}
+
+/* Compile a bundle on (q, v) or q alone: the tape, and native code (with
+ * its scattering function for the blocks) when the mode asks for it.
+ * exact: out was rewritten by dm_tape_optimize already (so that bundles
+ * sharing outputs compute them identically). */
+static int compile_bundle(builder *b, dm_bundle *p, size_t nout, const dm_expr *out,
+                        size_t nin, const dm_block *blk, size_t nblk, int exact)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  dm_bundle_src src = { b->ctx, b->in, sp->n, sp->npar, sp->par, b->in0,
+                        sp->par_values, sp->native };
+  return dm_bundle_compile(p, &src, nout, out, nin, blk, nblk, exact, b->err);
+}
+
+/* Every symbol or parameter in e must be one of allowed[0..na). */
+static int check_vars(builder *b, dm_expr e, const char *what, size_t na,
+                      const dm_expr *allowed, const dm_expr *vel)
+{
+  dm_expr fv[64];
+  long k = dm_expr_free_vars(b->ctx, e, fv, 64);
+  if (k < 0)
+    return dm_err_set(b->err, DM_EINVAL, "%s is not a valid expression", what);
+  for (long i = 0; i < k && i < 64; i++) {
+    int ok = 0;
+    for (size_t j = 0; j < na && !ok; j++)
+      ok = allowed[j] == fv[i];
+    if (ok)
+      continue;
+    for (size_t j = 0; vel != NULL && j < b->sp->n; j++)
+      if (vel[j] == fv[i])
+        return dm_err_set(b->err, DM_EINVAL, "%s depends on the velocity "
+                          "'%s'", what, dm_expr_name(b->ctx, fv[i]));
+    return dm_err_set(b->err, DM_EINVAL, "%s depends on %s '%s', which is "
+                      "not a coordinate, velocity or parameter", what,
+                      dm_expr_kind(b->ctx, fv[i]) == DM_EXPR_SYM ? "symbol"
+                      : "parameter", dm_expr_name(b->ctx, fv[i]));
+  }
+  return DM_OK;
+}
+
+static char *dupstr(const char *s)
+{
+  return s ? strdup(s) : NULL;
+}
+
+static int copy_names(lag_data *d, const dm_lagrangian_spec *sp,
+                      dm_expr_ctx *ctx)
+{
+  d->coords = calloc(sp->n, sizeof *d->coords);
+  d->params = calloc(sp->npar ? sp->npar : 1, sizeof *d->params);
+  d->par = calloc(sp->npar ? sp->npar : 1, sizeof *d->par);
+  if (!d->coords || !d->params || !d->par)
+    return -1;
+  for (size_t i = 0; i < sp->n; i++)
+    if (!(d->coords[i] = dupstr(sp->coord_names ? sp->coord_names[i]
+                                : dm_expr_name(ctx, sp->q[i]))))
+      return -1;
+  for (size_t i = 0; i < sp->npar; i++) {
+    if (!(d->params[i] = dupstr(sp->param_names ? sp->param_names[i]
+                                : dm_expr_name(ctx, sp->par[i]))))
+      return -1;
+    d->par[i] = sp->par_values ? sp->par_values[i] : 0.0;
+  }
+  if (sp->name && !(d->name = strdup(sp->name)))
+    return -1;
+  return 0;
+}
+
+/* Evaluate the mass matrix at the current parameters and test positive
+ * definiteness (Cholesky).  Returns 1 when M is SPD. */
+static int eval_mass(lag_data *d)
+{
+  size_t n = d->n, nw = d->massp.nregs;
+  double *buf = calloc(nw + 2 * n * n + 1, sizeof *buf);
+  if (buf == NULL)
+    return 0;
+  const double *M0 = dm_bundle_run_plain(&d->massp, buf, d->par);  /* q = v = 0 */
+  memcpy(d->mass, M0, n * n * sizeof *buf);
+  double *A = buf + nw + n * n;
+  memcpy(A, M0, n * n * sizeof *buf);
+  gsl_matrix_view M = gsl_matrix_view_array(A, n, n);
+  int spd = !nonfinite(d->mass, n * n) &&   /* needs dm_gsl_init() */
+            gsl_linalg_cholesky_decomp1(&M.matrix) == GSL_SUCCESS;
+  free(buf);
+  return spd;
+}
+
+/* Structure flags from the derived expressions; may compile the mass. */
+static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
+                            const dm_expr *Lvv, const dm_expr *Lvq,
+                            unsigned *flags)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n;
+  int mech = 1, constant = 1;
+  for (size_t i = 0; i < n * n; i++) {
+    mech &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->v);
+    constant &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->q);
+  }
+  *flags = mech ? DM_SYS_MECHANICAL : 0;
+  if (!mech || !constant)
+    return DM_OK;
+  double c;
+  for (size_t i = 0; i < n * n; i++)
+    if (!dm_expr_is_const(b->ctx, Lvq[i], &c) || c != 0)
+      return DM_OK;
+  /* Lv(q, 0) == 0: no term linear in v */
+  dm_expr *zero = malloc(n * sizeof *zero), *Lv0 = malloc(n * sizeof *Lv0);
+  int s = DM_ENOMEM, ok = 0;
+  if (zero && Lv0) {
+    for (size_t i = 0; i < n; i++)
+      zero[i] = dm_expr_const(b->ctx, 0.0);
+    s = dm_expr_subs(b->ctx, n, Lv, Lv0, n, sp->v, zero, b->err);
+    ok = s == DM_OK;
+    for (size_t i = 0; ok && i < n; i++)
+      ok = dm_expr_is_const(b->ctx, Lv0[i], &c) && c == 0;
+  }
+  free(zero);
+  free(Lv0);
+  if (s != DM_OK)
+    return s;
+  if (!ok)
+    return DM_OK;
+  d->mass = malloc(n * n * sizeof *d->mass);
+  if (d->mass == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  builder nb = *b;
+  dm_lagrangian_spec tsp = *sp;
+  tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
+  nb.sp = &tsp;
+  s = compile_bundle(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0, 0);
+  if (s != DM_OK)
+    return s;
+  d->mass_possible = 1;
+  if (eval_mass(d))
+    *flags |= DM_SYS_SEPARABLE;
+  return DM_OK;
+}
+
+/* For every request mask, the bundle that covers it at the least cost:
+ * tape instructions, plus the outputs copied when it has more arrays than
+ * asked for, four times that when the bundle runs on the tape (native
+ * code, where it compiled, always wins over a tape; with auto a bundle
+ * whose compilation failed falls back to its tape alone). */
+static void select_progs(lag_data *d)
+{
+  const dm_bundle *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
+  for (unsigned w = 0; w <= DM_LAG_ALL; w++) {
+    const dm_bundle *best = &d->all;
+    size_t bc = SIZE_MAX;
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++) {
+      const dm_bundle *p = ps[i];
+      if (p->tape == NULL || (w & ~p->have) != 0)
+        continue;
+      size_t c = dm_tape_ninstr(p->tape) + ((p->have & ~(w | DM_LAG_L)) ? p->nout : 0);
+      if (p->scatter == NULL)
+        c = 4 * c + 4;
+      if (c < bc) {
+        bc = c;
+        best = p;
+      }
+    }
+    d->sel[w] = best;
+  }
+}
+
+int dm_lagrangian_outputs(dm_expr_ctx *ctx, dm_expr L, size_t n, const dm_expr *in,
+                          dm_expr *out, dm_expr *ow, dm_err *err)
+{
+  size_t m = 2 * n, tri = n * (n + 1) / 2;
+  dm_expr *H = malloc(m * m * sizeof *H), *o = out + 1 + 2 * n;
+  if (H == NULL)
+    return dm_err_set(err, DM_ENOMEM, "out of memory");
+  out[0] = L;
+  /* gradient and Hessian in (q, v) at once: the Hessian routine shares the
+   * chain rule through common subexpressions between all the blocks */
+  if (dm_expr_grad(ctx, L, m, in, out + 1, NULL) != DM_OK ||
+      dm_expr_hessian(ctx, L, m, in, H, NULL) != DM_OK) {
+    const dm_err *ce = dm_expr_ctx_err(ctx);
+    free(H);
+    return dm_err_set(err, ce->status ? ce->status : DM_EFAILED, "L: %s",
+                      ce->msg[0] ? ce->msg : "cannot build the derivatives");
+  }
+  for (size_t i = 0; i < n; i++)            /* Lvv, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = H[(n + i) * m + n + j];
+  for (size_t i = 0; i < n; i++)            /* Lvq, full */
+    for (size_t j = 0; j < n; j++)
+      *o++ = H[(n + i) * m + j];
+  for (size_t i = 0; i < n; i++)            /* Lqq, upper triangle */
+    for (size_t j = i; j < n; j++)
+      *o++ = H[i * m + j];
+  free(H);
+  return dm_tape_optimize(ctx, 1 + 2 * n + 2 * tri + n * n, out, ow, err);
+}
+
+/* L and its derivatives: tapes grad and all, and the structure flags. */
+static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, tri = n * (n + 1) / 2;
+  size_t nall = 1 + 2 * n + 2 * tri + n * n;
+  dm_expr *out = malloc(nall * sizeof *out), *ow = malloc(nall * sizeof *ow);
+  dm_expr *Lvv = malloc(n * n * sizeof *Lvv);
+  int s = DM_ENOMEM;
+  if (!out || !ow || !Lvv) {
+    dm_err_set(b->err, s, "out of memory");
+    goto done;
+  }
+  /* rewritten once for both bundles: the gradient alone and with the
+   * Hessian are computed the same way, bit for bit */
+  if ((s = dm_lagrangian_outputs(b->ctx, sp->L, n, b->in, out, ow, b->err)) != DM_OK)
+    goto done;
+  const dm_expr *Lv = out + 1 + n, *Lvq = out + 1 + 2 * n + tri;
+  for (size_t i = 0, k = 1 + 2 * n; i < n; i++)
+    for (size_t j = i; j < n; j++, k++)
+      Lvv[i * n + j] = Lvv[j * n + i] = out[k];
+  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0 }, { 1, DM_BLK_VEC, n, 1, 0 },
+                           { 2, DM_BLK_VEC, n, 1, 0 }, { 3, DM_BLK_SYM, n, 1, 0 },
+                           { 4, DM_BLK_FULL, n, 1, 0 }, { 5, DM_BLK_SYM, n, 1, 0 } };
+  if ((s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK)
+    goto done;
+  if (d->mass_possible) {
+    /* separable (Lvq = 0, Lvv constant): Lq depends on q alone, and the
+     * integrators ask for Lq alone (Stormer-Verlet) or for Lq, Lv, Lqq
+     * (the Newton matrix, Lvv being the mass); both bundles from the same
+     * rewritten outputs, so their values are those of grad and all */
+    const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0 } };
+    const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0 }, { 2, DM_BLK_VEC, n, 1, 0 },
+                             { 5, DM_BLK_SYM, n, 1, 0 } };
+    memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
+    if ((s = compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
+        (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
+      goto done;
+  }
+  select_progs(d);
+done:
+  free(out);
+  free(ow);
+  free(Lvv);
+  return s;
+}
+
+int dm_lagrangian_force_outputs(dm_expr_ctx *ctx, size_t n, const dm_expr *F,
+                                const dm_expr *in, dm_expr *out, dm_err *err)
+{
+  memcpy(out, F, n * sizeof *out);
+  if (dm_expr_jacobian(ctx, n, F, n, in, out + n, NULL) != DM_OK ||
+      dm_expr_jacobian(ctx, n, F, n, in + n, out + n + n * n, NULL) != DM_OK) {
+    const dm_err *ce = dm_expr_ctx_err(ctx);
+    return dm_err_set(err, ce->status ? ce->status : DM_EFAILED, "force: %s",
+                      ce->msg[0] ? ce->msg : "cannot build the derivatives");
+  }
+  return dm_tape_optimize(ctx, n + 2 * n * n, out, out, err);
+}
+
+static int build_force(builder *b, lag_data *d)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, nall = n + 2 * n * n;
+  dm_expr *out = malloc(nall * sizeof *out);
+  if (out == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  const dm_block blk[] = { { 0, DM_BLK_VEC, n, 1, 0 }, { 1, DM_BLK_FULL, n, 1, 0 },
+                           { 2, DM_BLK_FULL, n, 1, 0 } };
+  int s = dm_lagrangian_force_outputs(b->ctx, n, sp->force, b->in, out, b->err);
+  if (s == DM_OK)
+    s = compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
+  if (s == DM_OK)
+    s = compile_bundle(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
+  free(out);
+  return s;
+}
+
+static int build_constraints(builder *b, lag_data *d)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, m = sp->m, tri = n * (n + 1) / 2;
+  size_t nall = m + m * n + m * tri;
+  dm_expr *out = malloc(nall * sizeof *out);
+  if (out == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  memcpy(out, sp->constraints, m * sizeof *out);
+  const dm_block blk[] = { { 0, DM_BLK_VEC, m, 1, 0 }, { 1, DM_BLK_VEC, m * n, 1, 0 },
+                           { 2, DM_BLK_SYM, n, m, n * n } };
+  dm_expr *G = out + m, *o = out + m + m * n;
+  int s = DM_OK;
+  if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)
+    s = ctx_fail(b, "constraints");
+  for (size_t a = 0; s == DM_OK && a < m; a++)
+    for (size_t i = 0; i < n; i++)
+      for (size_t j = i; j < n; j++)
+        *o++ = dm_expr_diff(b->ctx, G[a * n + i], sp->q[j]);
+  if (s == DM_OK && dm_expr_ctx_err(b->ctx)->status != DM_OK)
+    s = ctx_fail(b, "constraints");
+  if (s == DM_OK)
+    s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
+  if (s == DM_OK)
+    s = compile_bundle(b, &d->constr, m + m * n, out, n, blk, 3, 1);
+  if (s == DM_OK)
+    s = compile_bundle(b, &d->constr_all, nall, out, n, blk, 3, 1);
+  free(out);
+  return s;
+}
+
+static int check_spec(builder *b)
+{
+  const dm_lagrangian_spec *sp = b->sp;
+  size_t n = sp->n, na = 2 * n + sp->npar;
+  char what[64];
+  if (n == 0 || !sp->q || !sp->v || (sp->npar && !sp->par) ||
+      (sp->m && !sp->constraints))
+    return dm_err_set(b->err, DM_EINVAL, "a system needs n >= 1 coordinates, "
+                      "their velocities and the listed parameters");
+  for (size_t i = 0; i < 2 * n; i++)
+    if (dm_expr_kind(b->ctx, b->in[i]) != DM_EXPR_SYM)
+      return dm_err_set(b->err, DM_EINVAL, "%s %zu is not a symbol",
+                        i < n ? "coordinate" : "velocity", i % n + 1);
+  for (size_t i = 0; i < 2 * n; i++)
+    for (size_t j = 0; j < i; j++)
+      if (b->in[i] == b->in[j])
+        return dm_err_set(b->err, DM_EINVAL, "'%s' is listed twice among the "
+                          "coordinates and velocities",
+                          dm_expr_name(b->ctx, b->in[i]));
+  dm_expr *allowed = malloc(na * sizeof *allowed);
+  if (allowed == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  memcpy(allowed, b->in, 2 * n * sizeof *allowed);
+  if (sp->npar)
+    memcpy(allowed + 2 * n, sp->par, sp->npar * sizeof *allowed);
+  int s = check_vars(b, sp->L, "L", na, allowed, NULL);
+  for (size_t i = 0; s == DM_OK && sp->force && i < n; i++) {
+    snprintf(what, sizeof what, "force component %zu", i + 1);
+    s = check_vars(b, sp->force[i], what, na, allowed, NULL);
+  }
+  /* constraints: coordinates and parameters only */
+  memmove(allowed + n, allowed + 2 * n, sp->npar * sizeof *allowed);
+  for (size_t a = 0; s == DM_OK && a < sp->m; a++) {
+    snprintf(what, sizeof what, "constraint %zu", a + 1);
+    s = check_vars(b, sp->constraints[a], what, n + sp->npar, allowed, sp->v);
+  }
+  free(allowed);
+  return s;
+}
+
+static size_t bundle_need(const dm_bundle *p)
+{
+  return p->tape ? p->nregs + p->nout : 0;
+}
+
+int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
+                          dm_system *sys, dm_err *err)
+{
+  memset(sys, 0, sizeof *sys);
+  size_t n = sp->n;
+  builder b = { ctx, sp, NULL, NULL, err };
+  lag_data *d = calloc(1, sizeof *d);
+  b.in = malloc((2 * n + 1) * sizeof *b.in);
+  if (sp->q0 && sp->v0)
+    b.in0 = malloc((2 * n + 1) * sizeof *b.in0);
+  int s = DM_ENOMEM;
+  if (d == NULL || b.in == NULL || (sp->q0 && sp->v0 && b.in0 == NULL)) {
+    dm_err_set(err, s, "out of memory");
+    goto fail;
+  }
+  if (n) {
+    memcpy(b.in, sp->q, n * sizeof *b.in);
+    memcpy(b.in + n, sp->v, n * sizeof *b.in);
+  }
+  if (b.in0) {
+    memcpy(b.in0, sp->q0, n * sizeof *b.in0);
+    memcpy(b.in0 + n, sp->v0, n * sizeof *b.in0);
+  }
+  d->n = n;
+  d->m = sp->m;
+  d->npar = sp->npar;
+  if ((s = check_spec(&b)) != DM_OK)
+    goto fail;
+  if (copy_names(d, sp, ctx) != 0) {
+    s = dm_err_set(err, DM_ENOMEM, "out of memory");
+    goto fail;
+  }
+  unsigned flags = 0;
+  if ((s = build_lagrangian(&b, d, &flags)) != DM_OK ||
+      (sp->force && (s = build_force(&b, d)) != DM_OK) ||
+      (sp->m && (s = build_constraints(&b, d)) != DM_OK))
+    goto fail;
+
+  size_t need = 0;
+  const dm_bundle *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force,
+                            &d->force_all, &d->constr, &d->constr_all };
+  for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
+    if (bundle_need(ps[i]) > need)
+      need = bundle_need(ps[i]);
+  sys->name = d->name;
+  sys->n = n;
+  sys->npar = sp->npar;
+  sys->m = sp->m;
+  sys->coords = (const char *const *)d->coords;
+  sys->params = (const char *const *)d->params;
+  sys->par = d->par;
+  sys->flags = flags;
+  sys->mass = (flags & DM_SYS_SEPARABLE) ? d->mass : NULL;
+  sys->lagrangian = lag_eval;
+  sys->force = sp->force ? force_eval : NULL;
+  sys->constraints = sp->m ? constr_eval : NULL;
+  sys->data = d;
+  sys->work_size = need * sizeof(double);
+  sys->free_data = lag_free;
+  free(b.in);
+  free(b.in0);
+  return DM_OK;
+fail:
+  lag_free_data(d);
+  free(b.in);
+  free(b.in0);
+  memset(sys, 0, sizeof *sys);
+  return s;
+}
+
+int dm_lagrangian_refresh(dm_system *sys, dm_err *err)
+{
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return dm_err_set(err, DM_EINVAL, "not a system compiled from a Lagrangian");
+  lag_data *d = sys->data;
+  if (!d->mass_possible)
+    return DM_OK;
+  if (eval_mass(d)) {
+    sys->flags |= DM_SYS_SEPARABLE;
+    sys->mass = d->mass;
+  } else {
+    sys->flags &= ~(unsigned)DM_SYS_SEPARABLE;
+    sys->mass = NULL;
+  }
+  return DM_OK;
+}
+
+int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st)
+{
+  memset(st, 0, sizeof *st);
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return DM_EINVAL;
+  const lag_data *d = sys->data;
+  st->ninstr_grad = dm_tape_ninstr(d->grad.tape);
+  st->ninstr_all = dm_tape_ninstr(d->all.tape);
+  st->nregs_all = dm_tape_nregs(d->all.tape);
+  st->native_grad = d->grad.fn != NULL;
+  st->native_all = d->all.fn != NULL;
+  st->ninstr_force = d->force_all.tape ? dm_tape_ninstr(d->force_all.tape) : 0;
+  st->ninstr_constr = d->constr_all.tape ? dm_tape_ninstr(d->constr_all.tape) : 0;
+  st->ninstr_q = d->lq.tape ? dm_tape_ninstr(d->lq.tape) : 0;
+  st->ninstr_sep = d->qvqq.tape ? dm_tape_ninstr(d->qvqq.tape) : 0;
+  st->native_q = d->lq.fn != NULL;
+  st->native_sep = d->qvqq.fn != NULL;
+  return DM_OK;
+}

@@ -1,0 +1,99 @@
+/* native.h -- tapes compiled to machine code by the system C compiler.
+ *
+ * dm_native_compile emits straight-line C for a tape (one local double per
+ * instruction, the same operations in the same order, so results agree with
+ * the tape to the last bit in practice; each output stored as soon as it
+ * is computed), compiles it with $CC (else "cc")
+ * `-O1 -fPIC -shared -ffp-contract=off -fno-math-errno` (-O1: straight-line
+ * code of a few hundred temporaries runs faster than at -O2 or -O3 --
+ * less register pressure -- and compiles sooner; -fno-math-errno lets
+ * sqrt be one instruction and pairs sin/cos of one argument into sincos;
+ * no -ffast-math: results equal the tape's bit for bit) in a private
+ * mkdtemp directory
+ * (mode 0700) under $TMPDIR (else /tmp), loads it with dlopen and checks it
+ * against the tape on random points (relative agreement 1e-15, NaN equal to
+ * NaN).  Objects are cached under $XDG_CACHE_HOME/dmech (else
+ * ~/.cache/dmech; directory 0700, files 0600, written to a temporary name
+ * and renamed) keyed by the SHA-256 of the emitted source, the compiler
+ * command and its --version text; a cached object is loaded only when it is
+ * a regular file owned by the user and not writable by others.  The
+ * compiler runs through posix_spawn (never a shell); its stderr becomes the
+ * error message.
+ *
+ * Errors (the caller then uses the tape): DM_ENOTFOUND no compiler,
+ * DM_EFAILED compilation failed or the code disagrees with the tape,
+ * DM_EIO file or dlopen trouble, DM_EINTR interrupted, DM_ETIMEOUT the
+ * compiler ran longer than 300 s.  Nothing is printed.
+ *
+ * Ownership: dm_native_compile allocates, dm_native_free releases (NULL
+ * ok); the loaded code stays valid until then and does not refer to the
+ * tape.  The compiled function is re-entrant (no work buffer needed).
+ */
+#ifndef DM_NATIVE_H
+#define DM_NATIVE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/status.h"
+#include "expr/tape.h"
+
+/* What the caller wants (dm.config.native). */
+enum dm_native_mode {
+  DM_NATIVE_NEVER = 0,  /* always the tape */
+  DM_NATIVE_AUTO,       /* native when a compiler works, else the tape, silently */
+  DM_NATIVE_ALWAYS      /* native or an error */
+};
+
+typedef struct dm_native dm_native;
+
+/* out[nout] = outputs at (in, par), same contract as dm_tape_eval. */
+typedef void (*dm_native_fn)(const double *in, const double *par, double *out);
+
+/* Compile tape t.  in0 / par0 (may be NULL) are a typical point: the check
+ * against the tape uses points near it as well as random ones. */
+int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
+                      dm_native **nat, dm_err *err);
+void dm_native_free(dm_native *nat);
+
+dm_native_fn dm_native_function(const dm_native *nat);
+
+/* Element `elem` of array `arr` (arr < 32), for output `k` or input k. */
+typedef struct dm_native_map {
+  uint32_t k, arr, elem;
+} dm_native_map;
+
+/* Gathers its inputs and scatters its outputs itself: input i is
+ * in[inmap[i].arr][inmap[i].elem]; output k goes to out[arr][elem] for
+ * every outmap entry with that k whose bit (1 << arr) is set in mask
+ * (arrays whose bit is clear are not touched and may be NULL).  Returns 1
+ * when any output is NaN or infinite (the requested arrays are then
+ * partly written), else 0.  This is what a system callback needs without
+ * copying through buffers: when every mapped array is requested, each
+ * output goes straight to its places as soon as it is computed. */
+typedef int (*dm_native_scatter_fn)(const double *const *in, const double *par,
+                                    double *const *out, unsigned mask);
+
+/* As dm_native_compile, and also emit the scatter function for these maps
+ * (inmap has dm_tape_nin(t) entries; the maps are only read during the
+ * call).  Both functions are checked. */
+int dm_native_compile_mapped(const dm_tape *t, const double *in0,
+                             const double *par0, const dm_native_map *inmap,
+                             size_t nmap, const dm_native_map *outmap,
+                             dm_native **nat, dm_err *err);
+/* The scatter function, or NULL when compiled without maps. */
+dm_native_scatter_fn dm_native_scatter(const dm_native *nat);
+/* 1 if the object came from the cache, 0 if it was compiled now. */
+int dm_native_cached(const dm_native *nat);
+/* The cache key (64 hex digits). */
+const char *dm_native_key(const dm_native *nat);
+
+/* The C source emitted for t (malloc'ed, caller frees; NULL when out of
+ * memory). */
+char *dm_native_source(const dm_tape *t);
+
+/* "never" / "auto" / "always" and back (-1 for an unknown name). */
+const char *dm_native_mode_name(int mode);
+int dm_native_mode_parse(const char *name);
+
+#endif

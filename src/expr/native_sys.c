@@ -1,0 +1,407 @@
+/* native_sys.c -- the system side of native compilation: SHA-256 cache
+ * keys, running the compiler (posix_spawn, never a shell), private files
+ * and the object cache.  See native.h. */
+#include <config.h>
+#include "expr/native_impl.h"
+#include "core/interrupt.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <spawn.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+extern char **environ;
+
+#define CC_TIMEOUT 300.0      /* seconds */
+
+
+/* {==================================================================
+ * SHA-256 (FIPS 180-4), for cache keys
+ * =================================================================== */
+
+typedef struct sha256 {
+  uint32_t h[8];
+  uint64_t len;
+  unsigned char buf[64];
+  size_t nbuf;
+} sha256;
+
+static const uint32_t K256[64] = {
+  0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1,
+  0x923f82a4, 0xab1c5ed5, 0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3,
+  0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174, 0xe49b69c1, 0xefbe4786,
+  0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
+  0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147,
+  0x06ca6351, 0x14292967, 0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13,
+  0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85, 0xa2bfe8a1, 0xa81a664b,
+  0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
+  0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a,
+  0x5b9cca4f, 0x682e6ff3, 0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208,
+  0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2
+};
+
+#define ROR(x, n) (((x) >> (n)) | ((x) << (32 - (n))))
+
+static void sha_block(sha256 *s, const unsigned char *p)
+{
+  uint32_t w[64], v[8];
+  for (int i = 0; i < 16; i++)
+    w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 |
+           (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
+  for (int i = 16; i < 64; i++) {
+    uint32_t s0 = ROR(w[i - 15], 7) ^ ROR(w[i - 15], 18) ^ (w[i - 15] >> 3);
+    uint32_t s1 = ROR(w[i - 2], 17) ^ ROR(w[i - 2], 19) ^ (w[i - 2] >> 10);
+    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+  }
+  memcpy(v, s->h, sizeof v);
+  for (int i = 0; i < 64; i++) {
+    uint32_t S1 = ROR(v[4], 6) ^ ROR(v[4], 11) ^ ROR(v[4], 25);
+    uint32_t ch = (v[4] & v[5]) ^ (~v[4] & v[6]);
+    uint32_t t1 = v[7] + S1 + ch + K256[i] + w[i];
+    uint32_t S0 = ROR(v[0], 2) ^ ROR(v[0], 13) ^ ROR(v[0], 22);
+    uint32_t mj = (v[0] & v[1]) ^ (v[0] & v[2]) ^ (v[1] & v[2]);
+    memmove(v + 1, v, 7 * sizeof *v);
+    v[4] += t1;
+    v[0] = t1 + S0 + mj;
+  }
+  for (int i = 0; i < 8; i++)
+    s->h[i] += v[i];
+}
+
+static void sha_init(sha256 *s)
+{
+  static const uint32_t h0[8] = { 0x6a09e667, 0xbb67ae85, 0x3c6ef372,
+    0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19 };
+  memcpy(s->h, h0, sizeof h0);
+  s->len = 0;
+  s->nbuf = 0;
+}
+
+static void sha_update(sha256 *s, const void *data, size_t n)
+{
+  const unsigned char *p = data;
+  s->len += n;
+  while (n > 0) {
+    size_t k = 64 - s->nbuf < n ? 64 - s->nbuf : n;
+    memcpy(s->buf + s->nbuf, p, k);
+    s->nbuf += k;
+    p += k;
+    n -= k;
+    if (s->nbuf == 64) {
+      sha_block(s, s->buf);
+      s->nbuf = 0;
+    }
+  }
+}
+
+static void sha_hex(sha256 *s, char hex[65])
+{
+  uint64_t bits = s->len * 8;
+  unsigned char pad = 0x80, zero = 0, lenb[8];
+  sha_update(s, &pad, 1);
+  while (s->nbuf != 56)
+    sha_update(s, &zero, 1);
+  for (int i = 0; i < 8; i++)
+    lenb[i] = (unsigned char)(bits >> (56 - 8 * i));
+  sha_update(s, lenb, 8);
+  for (int i = 0; i < 8; i++)
+    snprintf(hex + 8 * i, 9, "%08x", (unsigned)s->h[i]);
+}
+
+/* {==================================================================
+ * running the compiler
+ * =================================================================== */
+
+static double now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Split $CC (else "cc") at blanks into argv[0..k), return k (0: none). */
+int dm_native__cc_words(char *copy, char **argv, int max)
+{
+  int k = 0;
+  char *save = NULL;
+  for (char *p = strtok_r(copy, " \t", &save); p != NULL && k < max;
+       p = strtok_r(NULL, " \t", &save))
+    argv[k++] = p;
+  return k;
+}
+
+/* Run argv with stdin from /dev/null and stdout + stderr captured into out
+ * (at most size-1 bytes kept, NUL-terminated).  *status is the exit code
+ * (128 + signal when killed).  Returns a dm status. */
+static int run(char *const argv[], char *out, size_t size, int *status,
+               dm_err *err)
+{
+  int fd[2];
+  if (pipe(fd) != 0)
+    return dm_err_set(err, DM_EIO, "native: pipe: %s", strerror(errno));
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&fa, fd[1], 1);
+  posix_spawn_file_actions_adddup2(&fa, fd[1], 2);
+  posix_spawn_file_actions_addclose(&fa, fd[0]);
+  posix_spawn_file_actions_addclose(&fa, fd[1]);
+  pid_t pid;
+  int rc = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
+  posix_spawn_file_actions_destroy(&fa);
+  close(fd[1]);
+  if (rc != 0) {
+    close(fd[0]);
+    return dm_err_set(err, rc == ENOENT ? DM_ENOTFOUND : DM_EIO,
+                      "native: cannot run C compiler '%s': %s", argv[0],
+                      strerror(rc));
+  }
+  size_t len = 0;
+  int result = DM_OK;
+  double t0 = now();
+  for (;;) {
+    struct pollfd p = { fd[0], POLLIN, 0 };
+    int k = poll(&p, 1, 50);
+    if (k > 0) {
+      char tmp[4096];
+      ssize_t r = read(fd[0], tmp, sizeof tmp);
+      if (r == 0)
+        break;
+      if (r > 0 && len + 1 < size) {
+        size_t m = (size_t)r < size - 1 - len ? (size_t)r : size - 1 - len;
+        memcpy(out + len, tmp, m);
+        len += m;
+      }
+      if (r < 0 && errno != EINTR)
+        break;
+    }
+    if (dm_interrupted() || now() - t0 > CC_TIMEOUT) {
+      result = dm_interrupted() ? DM_EINTR : DM_ETIMEOUT;
+      kill(pid, SIGKILL);
+      break;
+    }
+  }
+  out[len] = '\0';
+  close(fd[0]);
+  int ws;
+  while (waitpid(pid, &ws, 0) < 0 && errno == EINTR)
+    ;
+  *status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+  if (result == DM_EINTR)
+    return dm_err_set(err, DM_EINTR, "native: compilation interrupted");
+  if (result == DM_ETIMEOUT)
+    return dm_err_set(err, DM_ETIMEOUT, "native: %s ran longer than %.0f s",
+                      argv[0], CC_TIMEOUT);
+  /* glibc reports a failed exec as exit status 127 */
+  if (*status == 127 && len == 0)
+    return dm_err_set(err, DM_ENOTFOUND, "native: cannot run C compiler '%s'",
+                      argv[0]);
+  return DM_OK;
+}
+
+/* {==================================================================
+ * files and the cache
+ * =================================================================== */
+
+static int write_file(const char *path, const void *data, size_t n)
+{
+  int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    return -1;
+  const char *p = data;
+  while (n > 0) {
+    ssize_t w = write(fd, p, n);
+    if (w < 0 && errno == EINTR)
+      continue;
+    if (w <= 0) {
+      close(fd);
+      return -1;
+    }
+    p += w;
+    n -= (size_t)w;
+  }
+  return close(fd);
+}
+
+/* Whole file into a malloc'ed buffer, or NULL. */
+static char *read_file(const char *path, size_t *n)
+{
+  FILE *f = fopen(path, "rb");
+  if (f == NULL)
+    return NULL;
+  char *buf = NULL;
+  size_t len = 0, cap = 0;
+  for (;;) {
+    if (len == cap) {
+      cap = cap ? 2 * cap : 65536;
+      char *p = realloc(buf, cap);
+      if (p == NULL)
+        break;
+      buf = p;
+    }
+    size_t r = fread(buf + len, 1, cap - len, f);
+    len += r;
+    if (r == 0)
+      break;
+  }
+  int bad = ferror(f);
+  fclose(f);
+  if (bad || buf == NULL) {
+    free(buf);
+    return NULL;
+  }
+  *n = len;
+  return buf;
+}
+
+/* A directory we own, not accessible to others (created 0700 if missing). */
+static int private_dir(const char *path)
+{
+  struct stat st;
+  if (mkdir(path, 0700) != 0 && errno != EEXIST)
+    return -1;
+  if (lstat(path, &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid()
+      || (st.st_mode & 077) != 0)
+    return -1;
+  return 0;
+}
+
+/* $XDG_CACHE_HOME/dmech or $HOME/.cache/dmech into dir; -1 when there is
+ * no usable cache directory. */
+int dm_native__cache_dir(char *dir, size_t size)
+{
+  const char *x = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+  char base[4096];
+  if (x != NULL && x[0] == '/')
+    snprintf(base, sizeof base, "%s", x);
+  else if (home != NULL && home[0] == '/')
+    snprintf(base, sizeof base, "%s/.cache", home);
+  else
+    return -1;
+  /* the base may be missing: create it (and only it) privately */
+  if (mkdir(base, 0700) != 0 && errno != EEXIST)
+    return -1;
+  if ((size_t)snprintf(dir, size, "%s/dmech", base) >= size)
+    return -1;
+  return private_dir(dir);
+}
+
+/* A cached object is used only if it is a regular file of ours that
+ * nobody else can write. */
+int dm_native__trusted_file(const char *path)
+{
+  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0)
+    return 0;
+  struct stat st;
+  int ok = fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+           st.st_uid == getuid() && (st.st_mode & 022) == 0;
+  close(fd);
+  return ok;
+}
+
+/* Copy the object into the cache: temporary name, 0600, rename. */
+int dm_native__cache_store(const char *dir, const char *final, const char *obj)
+{
+  size_t n;
+  char *data = read_file(obj, &n), tmp[4200];
+  if (data == NULL)
+    return -1;
+  snprintf(tmp, sizeof tmp, "%s/.tmp-XXXXXX", dir);
+  int fd = mkstemp(tmp);
+  int bad = fd < 0;
+  for (size_t off = 0; !bad && off < n;) {
+    ssize_t w = write(fd, data + off, n - off);
+    if (w < 0 && errno == EINTR)
+      continue;
+    bad = w <= 0;
+    off += bad ? 0 : (size_t)w;
+  }
+  free(data);
+  if (fd >= 0) {
+    bad |= fchmod(fd, 0600) != 0;
+    bad |= close(fd) != 0;
+    if (bad || rename(tmp, final) != 0) {
+      unlink(tmp);
+      return -1;
+    }
+  }
+  return bad ? -1 : 0;
+}
+
+/* Compile src into dir/f.so (files in dir, which the caller removes). */
+int dm_native__build(char **ccargv, int ncc, const char *dir, const char *src,
+                 char *obj, size_t objsize, dm_err *err)
+{
+  char cpath[4200], flags[] = CC_FLAGS, *argv[64], msg[2048];
+  int k = 0, status;
+  snprintf(cpath, sizeof cpath, "%s/f.c", dir);
+  snprintf(obj, objsize, "%s/f.so", dir);
+  if (write_file(cpath, src, strlen(src)) != 0)
+    return dm_err_set(err, DM_EIO, "native: cannot write %s: %s", cpath,
+                      strerror(errno));
+  for (int i = 0; i < ncc; i++)
+    argv[k++] = ccargv[i];
+  k += dm_native__cc_words(flags, argv + k, 16);
+  argv[k++] = "-o";
+  argv[k++] = obj;
+  argv[k++] = cpath;
+  argv[k++] = "-lm";
+  argv[k] = NULL;
+  int s = run(argv, msg, sizeof msg, &status, err);
+  if (s != DM_OK)
+    return s;
+  if (status != 0)
+    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s",
+                      ccargv[0], status, msg);
+  return DM_OK;
+}
+
+void dm_native__remove_tree(const char *dir)
+{
+  char p[4200];
+  static const char *const files[] = { "f.c", "f.so" };
+  for (size_t i = 0; i < 2; i++) {
+    snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+    unlink(p);
+  }
+  rmdir(dir);
+}
+
+/* The key: SHA-256 of the source, the compiler command, its --version
+ * output and the flags. */
+int dm_native__make_key(char **ccargv, int ncc, const char *src, char key[65],
+                    dm_err *err)
+{
+  char *argv[40], ver[4096];
+  int status;
+  for (int i = 0; i < ncc; i++)
+    argv[i] = ccargv[i];
+  argv[ncc] = "--version";
+  argv[ncc + 1] = NULL;
+  int s = run(argv, ver, sizeof ver, &status, err);
+  if (s != DM_OK)
+    return s;
+  if (status != 0)
+    return dm_err_set(err, DM_ENOTFOUND, "native: '%s --version' failed "
+                      "(exit %d)", ccargv[0], status);
+  sha256 h;
+  sha_init(&h);
+  for (int i = 0; i < ncc; i++)
+    sha_update(&h, ccargv[i], strlen(ccargv[i]) + 1);
+  sha_update(&h, ver, strlen(ver) + 1);
+  sha_update(&h, CC_FLAGS, sizeof CC_FLAGS);
+  sha_update(&h, src, strlen(src));
+  sha_hex(&h, key);
+  return DM_OK;
+}
+

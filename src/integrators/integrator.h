@@ -1,0 +1,252 @@
+/* integrator.h -- one-step integrators for a dm_system, selected by name.
+ *
+ * Every method family is a `const dm_integrator_type` (GSL ode-initval2
+ * style) in its own file under src/integrators/; registry.c lists them.
+ * A new method is one file plus one line there.  Method names:
+ *   midpoint, gauss (stages >= 1), trapezoid, lobatto (IIIA-IIIB, stages >= 2),
+ *   prk (user tableau), composition (symmetric compositions of order 4/6/8),
+ *   rk4 (classical, non-symplectic), gsl:<stepper> (GSL odeiv2).
+ *
+ * State.  The primary state is (q, p), p = dL/dv.  step() maps (q0, p0) to
+ * (q1, p1) over a step h of either sign.  Conversions to (q, v) and to the
+ * two-point (q0, q1) form are below (discrete Legendre transforms).
+ *
+ * Ownership.  dm_integrator_new() allocates the integrator and every
+ * workspace any later step needs (a step never calls malloc); the system is
+ * borrowed and must outlive the integrator; dm_integrator_free() releases
+ * everything (NULL is a no-op).  One integrator must not be used by two
+ * threads at once; two integrators on one system may.
+ *
+ * Errors.  Functions return DM_OK or a DM_E* status and fill the dm_err (may
+ * be NULL): DM_ENOCONV (Newton did not converge; residual and tolerance in
+ * the message and in I->stats), DM_ESINGULAR (singular Jacobian, e.g. a
+ * Lagrangian whose d2L/dv2 is singular), DM_EDOM (a callback reported a
+ * point outside its domain, or a NaN appeared), DM_ECALLBACK, DM_EINVAL,
+ * DM_ENOTFOUND (unknown method), DM_EUNSUP, DM_EINTR (run interrupted).
+ * After a failed step the outputs are unspecified and the state is unchanged.
+ */
+#ifndef DM_INTEGRATOR_H
+#define DM_INTEGRATOR_H
+
+#include <stddef.h>
+#include "core/status.h"
+#include "core/system.h"
+#include "core/tableau.h"
+
+typedef struct dm_integrator dm_integrator;
+
+/* {==== options: one struct, described by a table so bindings can get and
+ * set fields by name (REBOUND style) ===================================== */
+
+#define DM_INTEG_STRMAX 32
+
+typedef struct dm_integ_opts {
+  int stages;          /* gauss >= 1, lobatto >= 2 (0: family default) */
+  double h;            /* default step size of run() (informational here) */
+  double tol;          /* Newton: stop when |update| <= tol * scale */
+  int maxiter;         /* Newton iteration cap */
+  int simplified;      /* Newton: reuse the factored Jacobian while it converges fast */
+  int order;           /* composition: 4, 6 or 8 */
+  char scheme[DM_INTEG_STRMAX];  /* composition table ("" = default for order) */
+  char base[DM_INTEG_STRMAX];    /* composition base step: trapezoid|midpoint */
+  int explicit_sv;     /* use explicit Stormer-Verlet/RATTLE when L is separable */
+  int adaptive;        /* gsl: adaptive steps inside each h */
+  double epsabs, epsrel;         /* gsl adaptive tolerances */
+  const dm_tableau *tableau;     /* prk: user tableau (copied by new()) */
+} dm_integ_opts;
+
+enum dm_opt_kind { DM_OPT_INT, DM_OPT_DOUBLE, DM_OPT_BOOL, DM_OPT_STRING };
+
+typedef struct dm_option_desc {
+  const char *name;
+  int kind;            /* dm_opt_kind */
+  size_t offset;       /* offsetof(dm_integ_opts, field) */
+  size_t size;         /* bytes (strings: buffer size) */
+  double min, max;     /* accepted range for numbers */
+  const char *doc;
+} dm_option_desc;
+
+/* The option table, terminated by an entry with name == NULL. */
+extern const dm_option_desc dm_integ_options[];
+
+void dm_integ_opts_init(dm_integ_opts *o);
+const dm_option_desc *dm_integ_option_find(const char *name);
+/* Set a number (int, double or bool option) or a string option by name;
+ * DM_ENOTFOUND for an unknown name, DM_EINVAL for a wrong kind or range. */
+int dm_integ_opts_set_number(dm_integ_opts *o, const char *name, double v, dm_err *e);
+int dm_integ_opts_set_string(dm_integ_opts *o, const char *name, const char *v, dm_err *e);
+/* Read an option: numbers into *num, strings into *str (either may be NULL). */
+int dm_integ_opts_get(const dm_integ_opts *o, const char *name, double *num,
+                      const char **str, dm_err *e);
+
+/* {==== the type object ================================================== */
+
+enum dm_integ_flags {
+  DM_INTEG_SYMPLECTIC  = 1u << 0,
+  DM_INTEG_SYMMETRIC   = 1u << 1,
+  DM_INTEG_EXPLICIT    = 1u << 2,  /* no nonlinear solve (this instance) */
+  DM_INTEG_VARIATIONAL = 1u << 3,  /* has a discrete Lagrangian: dm_integrator_dlegendre */
+  DM_INTEG_FORCES      = 1u << 4,  /* supports a generalized force */
+  DM_INTEG_CONSTRAINTS = 1u << 5,  /* supports holonomic constraints */
+  DM_INTEG_ADAPTIVE    = 1u << 6,  /* steps internally with error control */
+  DM_INTEG_EXACT_JAC   = 1u << 7   /* jacobian() is exact (else finite differences) */
+};
+
+typedef struct dm_integrator_type {
+  const char *name;          /* registry name; "gsl" matches "gsl:<variant>" */
+  const char *summary;       /* one line for help texts */
+  int order;                 /* nominal order; 0 when it depends on options */
+  unsigned flags;            /* nominal dm_integ_flags */
+  const char *const *options;  /* names of the options it reads, NULL-terminated */
+  /* Build I->state from I->sys, I->opt, I->variant; set I->order, I->flags. */
+  int (*alloc)(dm_integrator *I, dm_err *e);
+  /* (q0, p0) -> (q1, p1); outputs may alias inputs. */
+  int (*step)(dm_integrator *I, double h, const double *q0, const double *p0,
+              double *q1, double *p1, dm_err *e);
+  /* D(q1,p1)/D(q0,p0) (2n x 2n, row-major) at (q0, p0); NULL: not available
+   * (the generic code falls back to central differences). */
+  int (*jacobian)(dm_integrator *I, double h, const double *q0, const double *p0,
+                  double *DPhi, dm_err *e);
+  /* Discrete Legendre transforms of the method's discrete Lagrangian:
+   * p0 = -D1 Ld(q0, q1), p1 = D2 Ld(q0, q1), *Ld (any output may be NULL).
+   * NULL: not variational. */
+  int (*dlegendre)(dm_integrator *I, double h, const double *q0, const double *q1,
+                   double *p0, double *p1, double *Ld, dm_err *e);
+  /* Optional fast path of the run loop: up to nsteps steps of h in place
+   * on (q, p), polling dm_interrupted() before each step (DM_EINTR, no
+   * message).  *done = steps completed; on any failure q, p hold the state
+   * after *done steps.  NULL: the run loop calls step() repeatedly. */
+  int (*advance)(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                 long *done, dm_err *e);
+  /* Forget step history (predictor, compensated-summation carries). */
+  void (*reset)(dm_integrator *I);
+  void (*free)(dm_integrator *I);
+} dm_integrator_type;
+
+/* Statistics of the last step and running totals. */
+typedef struct dm_integ_stats {
+  int iters;            /* Newton iterations of the last step (0 if explicit) */
+  int jacs;             /* Jacobian factorisations in the last step */
+  double residual;      /* final max-norm residual / update of the last solve */
+  double tol;           /* the tolerance it was compared with */
+  long steps;           /* steps taken since new() or reset */
+  long iters_total;
+} dm_integ_stats;
+
+struct dm_integrator {
+  const dm_integrator_type *type;
+  const dm_system *sys;            /* borrowed */
+  size_t n, m;                     /* coordinates, constraints */
+  dm_integ_opts opt;               /* private copy (tableau copied into state) */
+  char variant[DM_INTEG_STRMAX];   /* text after "name:" (gsl stepper) */
+  char name[2 * DM_INTEG_STRMAX];  /* full method name as requested */
+  int order;                       /* actual order of this instance */
+  unsigned flags;                  /* actual dm_integ_flags */
+  dm_integ_stats stats;
+  void *state;                     /* family private */
+  struct dm_legendre_ws *leg;      /* Legendre-map workspace (velocity solves) */
+  double *scratch;                 /* 8n doubles for the generic layer */
+};
+
+/* {==== registry and life cycle ========================================== */
+
+/* Type for a method name ("gauss", "gsl:rk8pd" -> the gsl type); NULL if
+ * unknown.  *variant_out (may be NULL) points into name after ':'. */
+const dm_integrator_type *dm_integrator_lookup(const char *name, const char **variant_out);
+/* The registered types, NULL-terminated. */
+const dm_integrator_type *const *dm_integrator_types(void);
+
+/* Create an integrator for sys with method name and options (NULL: defaults).
+ * On error *out is NULL and nothing is leaked. */
+int dm_integrator_new(const dm_system *sys, const char *method,
+                      const dm_integ_opts *opts, dm_integrator **out, dm_err *e);
+void dm_integrator_free(dm_integrator *I);
+void dm_integrator_reset(dm_integrator *I);
+
+/* One step (q0, p0) -> (q1, p1); h may be negative.  Outputs may alias the
+ * inputs.  Checks the result for NaN (DM_EDOM). */
+int dm_integrator_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                       double *q1, double *p1, dm_err *e);
+
+/* {==== state conversions ================================================ */
+
+/* p = dL/dv (q, v). */
+int dm_integrator_momentum(dm_integrator *I, const double *q, const double *v,
+                           double *p, dm_err *e);
+/* v solving dL/dv (q, v) = p by Newton (v holds the initial guess on entry
+ * when guess != 0, else the guess is 0).  DM_ESINGULAR when d2L/dv2 is
+ * singular (the Lagrangian is not regular). */
+int dm_integrator_velocity(dm_integrator *I, const double *q, const double *p,
+                           double *v, int guess, dm_err *e);
+/* E = p.v - L at (q, v). */
+int dm_integrator_energy(dm_integrator *I, const double *q, const double *v,
+                         double *E, dm_err *e);
+/* Discrete Legendre transforms (variational methods only): p0 = -D1 Ld,
+ * p1 = D2 Ld, Ld (outputs may be NULL). */
+int dm_integrator_dlegendre(dm_integrator *I, double h, const double *q0,
+                            const double *q1, double *p0, double *p1, double *Ld,
+                            dm_err *e);
+/* DEL step (q_prev, q_cur) -> q_next: p_cur = D2 Ld(q_prev, q_cur), then one
+ * step from (q_cur, p_cur). */
+int dm_integrator_del_step(dm_integrator *I, double h, const double *q_prev,
+                           const double *q_cur, double *q_next, dm_err *e);
+/* Discrete momentum along a cyclic direction xi (n): J_d = xi . D2 Ld(q0, q1). */
+int dm_integrator_discrete_momentum(dm_integrator *I, double h, const double *q0,
+                                    const double *q1, const double *xi, double *J,
+                                    dm_err *e);
+
+/* {==== runs ============================================================= */
+
+/* Sample sink supplied by the trajectory module: return 0 to continue,
+ * non-zero to stop the run (DM_ECALLBACK). */
+typedef int (*dm_sink_fn)(void *ctx, double t, const double *q, const double *p,
+                          const double *v);
+
+typedef struct dm_run_info {
+  long steps;           /* steps completed */
+  double t;             /* time reached */
+  long samples;         /* samples emitted */
+  int status;           /* final status */
+  double residual, tol; /* of the last (failed) Newton solve */
+} dm_run_info;
+
+/* Take nsteps steps of size h from (t0, q, p), updating q, p in place.
+ * Emits (t, q, p, v) through sink (may be NULL) at step 0 and every `every`
+ * steps, and the final state if it was not emitted.  Polls dm_interrupted()
+ * every step.  On DM_EINTR, Newton failure, NaN state or sink stop, it stops:
+ * q, p hold the last good state, which is emitted if it had not been, and
+ * the message says at which step and time it stopped.  info may be NULL. */
+int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double h,
+                      long nsteps, long every, dm_sink_fn sink, void *ctx,
+                      dm_run_info *info, dm_err *e);
+
+/* {==== diagnostics ====================================================== */
+
+/* DPhi (2n x 2n) of one step at (q0, p0): exact (implicit differentiation of
+ * the converged step equations, or differentiation through explicit stages)
+ * when I->flags has DM_INTEG_EXACT_JAC, else central differences.
+ * Not available for constrained systems (DM_EUNSUP). */
+int dm_integrator_jacobian(dm_integrator *I, double h, const double *q0,
+                           const double *p0, double *DPhi, dm_err *e);
+/* max_ij |(DPhi^T J DPhi - J)_ij| with J = [[0, I], [-I, 0]]. */
+int dm_integrator_symplecticity_defect(dm_integrator *I, double h, const double *q0,
+                                       const double *p0, double *defect, dm_err *e);
+/* n steps with h then n with -h from (q0, p0); *dev = max-norm distance
+ * from (q0, p0). */
+int dm_integrator_reversal(dm_integrator *I, double h, long n, const double *q0,
+                           const double *p0, double *dev, dm_err *e);
+/* Least-squares slope of log(err) against log(h) (k >= 2 points, all > 0);
+ * NaN if the data are unusable. */
+double dm_order_fit(const double *h, const double *err, size_t k);
+/* Empirical order: integrate from (q0, p0) to time T with each step h[i]
+ * (T/h[i] rounded to whole steps, h adjusted), compare with the reference
+ * (qref, pref) at T (NULL: computed with a high-order method and a small
+ * step), errors (2-norm over q and p) into err[i] (may be NULL), fitted
+ * slope into *order. */
+int dm_integrator_order_estimate(const dm_system *sys, const char *method,
+                                 const dm_integ_opts *opts, const double *q0,
+                                 const double *p0, double T, const double *h, size_t k,
+                                 const double *qref, const double *pref, double *err,
+                                 double *order, dm_err *e);
+
+#endif

@@ -1,0 +1,677 @@
+/* prk_engine.c -- implicit symplectic PRK step for a Lagrangian system.
+ *
+ * Unknowns are the s stage velocities V_i = Qdot_i (spec routh.md §3):
+ *   Q_i = q0 + h sum_j a_ij V_j,
+ *   R_i = Lv(Q_i, V_i) - p0 - h sum_j at_ij W_j = 0,   W_j = Lq(Q_j, V_j) + F(Q_j, V_j)
+ *   q1 = q0 + h sum_j b_j V_j,   p1 = p0 + h sum_j b_j W_j
+ * (W includes the generalized force: discrete Lagrange-d'Alembert, spec §6).
+ * Newton uses the exact Jacobian
+ *   dR_i/dV_k = d_ik Lvv_i + h a_ik Lvq_i - h at_ik (Lvq_k^T + Fv_k)
+ *               - h^2 sum_j at_ij a_jk (Lqq_j + Fq_j),
+ * factored with GSL LU (by default as a simplified Newton: the Jacobian
+ * factored at the first iterate is reused while the updates contract at
+ * least tenfold, and refreshed otherwise; option simplified = false
+ * refactors every iteration), and iterates to round-off with the stopping
+ * rule of src/core/newton.h (scaled update <= tol, default 10 eps, or a
+ * round-off stall below DM_NEWTON_ACCEPT = 1e-10); at most maxiter
+ * iterations (failure: DM_ENOCONV with the update, residual and tolerance).
+ * The predictor extrapolates the previous step's stage-velocity polynomial
+ * (nodes c, values V) to the new stage times; without history (or with
+ * repeated nodes) it starts from the previous stages or from v(q0, p0).
+ * q and p increments are added with Kahan compensation; the carries persist
+ * while steps continue from the previous output.
+ *
+ * The discrete Legendre transforms solve the boundary problem: unknowns V and
+ * p0 with sum_j b_j V_j = (q1 - q0)/h; then p1 = p0 + h sum b_j W_j and
+ * Ld = h sum b_i L(Q_i, V_i) (Suris; thesis Thm 2.12).
+ *
+ * The Jacobian of the step map comes from the implicit function theorem on
+ * R(V; q0, p0) = 0 at the converged stages:
+ *   dV = -J^{-1} [dR/dq0 | dR/dp0],  dR_i/dq0 = Lvq_i - h sum_j at_ij D_j,
+ *   dR_i/dp0 = -I, then dq1 = dq0 + h sum b_j dV_j,
+ *   dp1 = dp0 + h sum_j b_j (D_j dQ_j + Bm_j dV_j).
+ */
+#include <config.h>
+#include "integrators/prk_impl.h"
+#include "integrators/prk_kernels.h"
+#include "core/interrupt.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static size_t nunk(const dm_prk *P, int mode)
+{
+  switch (mode) {
+  case DM_PRK_CSTEP: return P->sn + P->nK * P->m + P->m;
+  case DM_PRK_DLEG: return P->sn + P->n;
+  default: return P->sn;
+  }
+}
+
+int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
+                 int maxiter, int explicit_sv, dm_prk **out, dm_err *e)
+{
+  dm_prk *P = calloc(1, sizeof *P);
+  size_t n = sys->n, s = t->s, m = sys->m, nn = n * n, sn = s * n, i, j, tot;
+  size_t extra;
+  double *d;
+  int st;
+  *out = NULL;
+  if (P == NULL)
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  P->sys = sys;
+  P->n = n;
+  P->s = s;
+  P->m = m;
+  P->sn = sn;
+  P->nn = nn;
+  P->forced = sys->force != NULL;
+  P->sep = (sys->flags & DM_SYS_SEPARABLE) && sys->mass != NULL && !P->forced;
+  P->tol = tol;
+  P->maxiter = maxiter;
+  P->simplified = 1;
+  P->E_ratio = NAN;
+  if ((P->tab = dm_tableau_copy(t)) == NULL) {
+    free(P);
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  }
+  if (m > 0 && (st = dm_prk_constr_layout(P, e)) != DM_OK) {
+    dm_tableau_free(P->tab);
+    free(P);
+    return st;
+  }
+  extra = P->nK * m + m > n ? P->nK * m + m : n;
+  P->Nmax = sn + extra;
+  tot = P->Nmax * P->Nmax + 3 * P->Nmax + 5 * sn + 7 * s * nn + s
+        + (s + 2) * (m + m * n + m * nn) + 6 * n + P->Nmax * 2 * n
+        + sn + P->Nmax + 2 * n + s * s + 2 * n + nn + n;
+  d = calloc(tot, sizeof(double));
+  P->perm = calloc(P->Nmax, sizeof(size_t));
+  P->work = sys->work_size ? malloc(sys->work_size) : NULL;
+  P->leg = dm_legendre_alloc(sys);
+  if (d == NULL || P->perm == NULL || (sys->work_size && P->work == NULL) || P->leg == NULL) {
+    free(d);
+    P->Jm = NULL;
+    dm_prk_free(P);
+    return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+  }
+#define TAKE(ptr, cnt) do { (ptr) = d; d += (cnt); } while (0)
+  TAKE(P->Jm, P->Nmax * P->Nmax);
+  TAKE(P->R, P->Nmax);
+  TAKE(P->X, P->Nmax);
+  TAKE(P->hx, P->Nmax);
+  TAKE(P->Q, sn); TAKE(P->Lq, sn); TAKE(P->Lv, sn); TAKE(P->W, sn); TAKE(P->F, sn);
+  TAKE(P->Lvv, s * nn); TAKE(P->Lvq, s * nn); TAKE(P->Lqq, s * nn);
+  TAKE(P->Fq, s * nn); TAKE(P->Fv, s * nn); TAKE(P->D, s * nn); TAKE(P->Bm, s * nn);
+  TAKE(P->Lval, s);
+  TAKE(P->g, (s + 2) * m); TAKE(P->G, (s + 2) * m * n); TAKE(P->Hc, (s + 2) * m * nn);
+  TAKE(P->q1w, n); TAKE(P->p1w, n); TAKE(P->v1w, n); TAKE(P->dq, n); TAKE(P->dp, n);
+  TAKE(P->tmp, n);
+  TAKE(P->rhs, P->Nmax * 2 * n);
+  TAKE(P->hV, sn); TAKE(P->hq1, n); TAKE(P->hp1, n); TAKE(P->E, s * s);
+  TAKE(P->cq, n); TAKE(P->cp, n); TAKE(P->Minv, nn); TAKE(P->svf, n);
+#undef TAKE
+  P->distinct_nodes = 1;
+  for (i = 0; i < s; i++)
+    for (j = 0; j < i; j++)
+      if (fabs(t->c[i] - t->c[j]) < 1e-8)
+        P->distinct_nodes = 0;
+  if (explicit_sv && (st = dm_prk_verlet_setup(P, e)) != DM_OK) {
+    dm_prk_free(P);
+    return st;
+  }
+  *out = P;
+  return DM_OK;
+}
+
+void dm_prk_free(dm_prk *P)
+{
+  if (P == NULL)
+    return;
+  free(P->Jm);
+  free(P->perm);
+  free(P->work);
+  dm_legendre_free(P->leg);
+  dm_tableau_free(P->tab);
+  free(P);
+}
+
+void dm_prk_reset(dm_prk *P)
+{
+  P->hist = 0;
+  P->svf_valid = 0;
+  P->E_ratio = NAN;
+  memset(P->cq, 0, P->n * sizeof(double));
+  memset(P->cp, 0, P->n * sizeof(double));
+}
+
+int dm_prk_is_explicit(const dm_prk *P)
+{
+  return P->explicit_sv;
+}
+
+/* Evaluate L (and the force) at stage i: gradients always, second
+ * derivatives when jac; W, D, Bm derived. */
+int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
+{
+  size_t n = P->n, nn = P->nn, a, b;
+  double *Qi = P->Q + i * n, *Vi = P->X + i * n;
+  dm_lag_out o = {0, P->Lq + i * n, P->Lv + i * n, P->Lvv + i * nn, P->Lvq + i * nn,
+                  P->Lqq + i * nn};
+  /* a separable L has Lvv = M (sys->mass, current parameters) and Lvq = 0:
+   * only Lqq is asked for with the Jacobian, and Lvq, Bm stay zero */
+  unsigned what = DM_LAG_Q | DM_LAG_V | (want_L ? DM_LAG_L : 0u)
+                  | (jac ? (P->sep ? DM_LAG_QQ : (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ)) : 0u);
+  int st = dm_eval_lag(P->sys, Qi, Vi, what, &o, P->work, e);
+  if (st != DM_OK)
+    return st;
+  P->Lval[i] = o.L;
+  if (!P->forced) {
+    /* F, Fq, Fv stay zero: W = Lq, D = Lqq, Bm = Lvq^T without the additions */
+    dm_vcopy(P->W + i * n, P->Lq + i * n, n);
+    if (jac) {
+      const double *Lvq = P->Lvq + i * nn;
+      double *Bm = P->Bm + i * nn;
+      dm_vcopy(P->D + i * nn, P->Lqq + i * nn, nn);
+      if (P->sep) {
+        dm_vcopy(P->Lvv + i * nn, P->sys->mass, nn);
+        return DM_OK;
+      }
+      for (a = 0; a < n; a++)
+        for (b = 0; b < n; b++)
+          Bm[a * n + b] = Lvq[b * n + a];
+    }
+    return DM_OK;
+  }
+  {
+    unsigned fw = DM_FORCE_F | (jac ? (DM_FORCE_Q | DM_FORCE_V) : 0u);
+    st = dm_eval_force(P->sys, Qi, Vi, fw, P->F + i * n, P->Fq + i * nn, P->Fv + i * nn,
+                       P->work, e);
+    if (st != DM_OK)
+      return st;
+  }
+  for (a = 0; a < n; a++)
+    P->W[i * n + a] = P->Lq[i * n + a] + P->F[i * n + a];
+  if (jac)
+    for (a = 0; a < n; a++)
+      for (b = 0; b < n; b++) {
+        P->D[i * nn + a * n + b] = P->Lqq[i * nn + a * n + b] + P->Fq[i * nn + a * n + b];
+        P->Bm[i * nn + a * n + b] = P->Lvq[i * nn + b * n + a] + P->Fv[i * nn + a * n + b];
+      }
+  return DM_OK;
+}
+
+/* The stage-velocity block of the Newton matrix (row stride N):
+ *   J_ik = d_ik Lvv_i + h a_ik Lvq_i - h at_ik Bm_k - sum_j (h^2 at_ij a_jk) D_j,
+ * each entry accumulated in a register (restrict: the arrays never alias). */
+static void newton_matrix(dm_prk *P, double h, size_t N)
+{
+  const size_t n = P->n, s = P->s, nn = P->nn;
+  const double *restrict A = P->tab->a, *restrict At = P->tab->at;
+  const double *restrict Lvv = P->Lvv, *restrict Lvq = P->Lvq, *restrict Bm = P->Bm;
+  const double *restrict D = P->D;
+  double *restrict Jm = P->Jm, cj[DM_TABLEAU_SMAX];
+  const int sep = P->sep;       /* Lvq = Bm = 0 */
+  size_t i, j, k, a, c;
+  for (i = 0; i < s; i++)
+    for (k = 0; k < s; k++) {
+      const double hak = h * A[i * s + k], hatk = h * At[i * s + k];
+      const double *Lvqi = Lvq + i * nn, *Bmk = Bm + k * nn, *Lvvi = Lvv + i * nn;
+      for (j = 0; j < s; j++)
+        cj[j] = h * h * At[i * s + j] * A[j * s + k];
+      for (a = 0; a < n; a++) {
+        double *Jr = Jm + (i * n + a) * N + k * n;
+        for (c = 0; c < n; c++) {
+          double v = sep ? 0.0 : hak * Lvqi[a * n + c] - hatk * Bmk[a * n + c];
+          if (i == k)
+            v += Lvvi[a * n + c];
+          for (j = 0; j < s; j++)
+            v -= cj[j] * D[j * nn + a * n + c];
+          Jr[c] = v;
+        }
+      }
+    }
+}
+
+/* Residual (and Newton matrix when jac) of the stage equations at X. */
+static int assemble(dm_prk *P, int mode, double h, const double *q0, const double *p0,
+                    const double *q1t, int jac, dm_err *e)
+{
+  const size_t n = P->n, s = P->s, sn = P->sn, N = nunk(P, mode);
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  const double *V = P->X, *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
+  size_t i, j, a;
+  int st;
+  {
+    double *restrict Q = P->Q;   /* restrict in these blocks only: the */
+    for (i = 0; i < s; i++)      /* stage evaluation reads and writes P */
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += A[i * s + j] * V[j * n + a];
+        Q[i * n + a] = q0[a] + h * acc;
+      }
+  }
+  for (i = 0; i < s; i++)
+    if ((st = dm_prk_eval_stage(P, i, jac, mode == DM_PRK_DLEG, e)) != DM_OK)
+      return st;
+  {
+    const double *restrict W = P->W, *restrict Lv = P->Lv;
+    double *restrict R = P->R;
+    for (i = 0; i < s; i++)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += At[i * s + j] * W[j * n + a];
+        R[i * n + a] = Lv[i * n + a] - pp[a] - h * acc;
+      }
+    if (mode == DM_PRK_DLEG)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (j = 0; j < s; j++)
+          acc += b[j] * V[j * n + a];
+        R[sn + a] = acc - (q1t[a] - q0[a]) / h;
+      }
+  }
+  if (jac) {
+    if (N > sn)
+      memset(P->Jm, 0, N * N * sizeof(double));
+    newton_matrix(P, h, N);
+    P->lvv_norm = dm_norm_inf(P->Lvv, s * P->nn);
+    if (mode == DM_PRK_DLEG)
+      for (i = 0; i < s; i++)
+        for (a = 0; a < n; a++) {
+          P->Jm[(i * n + a) * N + sn + a] = -1.0;
+          P->Jm[(sn + a) * N + i * n + a] = b[i];
+        }
+  }
+  if (mode == DM_PRK_CSTEP)
+    return dm_prk_constr_assemble(P, h, q0, jac, e);
+  return DM_OK;
+}
+
+/* Scaled size of the Newton update held in R: velocities relative to
+ * max(|V|, momentum scale / |Lvv|), multipliers and p0 relative to
+ * max(|x|, momentum scale) with momentum scale |p| + |h| |W|.  rv and xv
+ * are max |R| and max |X| over the velocity block (computed by the caller
+ * while it applied the update). */
+static double update_norm(const dm_prk *P, int mode, double h, const double *p0, double rv,
+                          double xv)
+{
+  size_t sn = P->sn, N = nunk(P, mode);
+  const double *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
+  double ms = dm_norm_inf(pp, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
+  double lv = P->lvv_norm;      /* Lvv changes only with the Jacobian */
+  double vs = dm_max3(xv, lv > 0 ? ms / lv : 0.0, DBL_MIN);
+  double d = rv / vs;
+  if (N > sn) {
+    double xs = dm_max3(dm_norm_inf(P->X + sn, N - sn), ms, DBL_MIN);
+    d = dm_max2(d, dm_norm_inf(P->R + sn, N - sn) / xs);
+  }
+  return d;
+}
+
+int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
+{
+  size_t n = P->n, i;
+  char bq[160], bv[160];
+  for (i = 0; i < P->s; i++) {
+    memcpy(P->Jm, P->Lvv + i * P->nn, P->nn * sizeof(double));
+    if (dm_smalllu_factor(P->Jm, n, P->perm) != DM_OK)
+      return dm_err_set(e, DM_ESINGULAR,
+                        "d2L/dv2 is singular at stage %zu (q = %s, v = %s): the Lagrangian of "
+                        "'%s' is not regular (its Hessian in the velocities must be invertible)",
+                        i + 1, dm_fmt_vec(bq, sizeof bq, P->Q + i * n, n),
+                        dm_fmt_vec(bv, sizeof bv, P->X + i * n, n),
+                        P->sys->name ? P->sys->name : "system");
+  }
+  return dm_err_set(e, DM_ESINGULAR, "singular Newton matrix of the %s (h = %g)%s", what, h,
+                    P->m ? "; the constraint gradients may be linearly dependent"
+                         : "; try a smaller step");
+}
+
+static int newton(dm_prk *P, int mode, double h, const double *q0, const double *p0,
+                  const double *q1t, dm_integ_stats *stt, dm_err *e)
+{
+  size_t N = nunk(P, mode), i;
+  double d = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st, ok = 0, jac = 1, njac = 0;
+  for (it = 1; it <= P->maxiter; it++) {
+    if ((st = assemble(P, mode, h, q0, p0, q1t, jac, e)) != DM_OK)
+      return st;
+    rn = dm_norm_inf(P->R, N);
+    if (!isfinite(rn))
+      return dm_err_set(e, DM_EDOM, "non-finite residual in the stage equations (h = %g, iteration %d)",
+                        h, it);
+    if (jac) {
+      njac++;
+      st = dm_smalllu_factor(P->Jm, N, P->perm);
+      if (st == DM_ESINGULAR)
+        return dm_prk_singular(P, "stage equations", h, e);
+      if (st != DM_OK)
+        return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
+    }
+    dm_smalllu_solve(P->Jm, N, P->perm, P->R);
+    {
+      /* X -= R; max |R| and max |X| of the velocities on the way (a NaN
+       * in either makes d NaN: the test below catches it) */
+      double *X = P->X, rv = 0.0, xv = 0.0;
+      const double *R = P->R;
+      int nan = 0;
+      for (i = 0; i < P->sn; i++) {
+        double r = fabs(R[i]), x;
+        X[i] -= R[i];
+        x = fabs(X[i]);
+        rv = r > rv ? r : rv;
+        xv = x > xv ? x : xv;
+        nan |= (r != r) | (x != x);
+      }
+      for (; i < N; i++)
+        X[i] -= R[i];
+      d = update_norm(P, mode, h, p0, nan ? NAN : rv, xv);
+    }
+    if (!isfinite(d))
+      return dm_err_set(e, DM_EDOM, "non-finite Newton update (h = %g)", h);
+    /* at the tolerance, or in the round-off regime once the updates stop
+     * contracting (newton.h) */
+    if (dm_newton_done(&stop, d, P->tol)) {
+      ok = 1;
+      break;
+    }
+    /* simplified Newton: keep the factored exact Jacobian while the updates
+     * contract at least tenfold, otherwise refresh it */
+    jac = !P->simplified || d > 0.1 * dlast;
+    dlast = d;
+  }
+  if (it > P->maxiter)
+    it = P->maxiter;
+  if (stt) {
+    stt->iters = it;
+    stt->jacs = njac;
+    stt->residual = d;
+    stt->tol = P->tol;
+    stt->iters_total += it;
+  }
+  P->njac = njac;
+  if (!ok)
+    return dm_err_set(e, DM_ENOCONV,
+                      "Newton on the stage equations did not converge in %d iterations: "
+                      "relative update %.3g > tol %.3g (residual %.3g, h = %g)",
+                      it, d, P->tol, rn, h);
+  /* The stage forces were evaluated before the last update; when that update
+   * is at round-off they are the converged ones, otherwise evaluate again. */
+  if (d <= 1e-12 && mode != DM_PRK_DLEG)
+    return DM_OK;
+  return assemble(P, mode, h, q0, p0, q1t, 0, e);
+}
+
+static int predict(dm_prk *P, double h, const double *q0, const double *p0, int cont,
+                   dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, N = nunk(P, P->m ? DM_PRK_CSTEP : DM_PRK_STEP);
+  if (cont && P->distinct_nodes) {
+    dm_prk_extrapolate(s, n, P->tab->c, h / P->hist_h, P->E, &P->E_ratio, P->hV, P->X);
+  } else if (cont) {
+    memcpy(P->X, P->hV, sn * sizeof(double));
+  } else {
+    int st;
+    if (P->hist)
+      memcpy(P->v1w, P->hV + (s - 1) * n, n * sizeof(double));
+    st = dm_legendre_velocity(P->leg, q0, p0, P->v1w, P->hist, e);
+    if (st != DM_OK)
+      return st;
+    for (i = 0; i < s; i++)
+      memcpy(P->X + i * n, P->v1w, n * sizeof(double));
+  }
+  if (N > sn) {
+    if (cont)
+      memcpy(P->X + sn, P->hx, (N - sn) * sizeof(double));
+    else
+      memset(P->X + sn, 0, (N - sn) * sizeof(double));
+  }
+  return DM_OK;
+}
+
+int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
+                double *q1, double *p1, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, a;
+  const double *b = P->tab->b;
+  int mode = P->m ? DM_PRK_CSTEP : DM_PRK_STEP, st, bad = 0;
+  int cont = P->hist && dm_same(q0, P->hq1, n) && dm_same(p0, P->hp1, n);
+  if (!cont) {
+    memset(P->cq, 0, n * sizeof(double));
+    memset(P->cp, 0, n * sizeof(double));
+    P->svf_valid = 0;
+  }
+  if (h == 0.0) {
+    memmove(q1, q0, n * sizeof(double));
+    memmove(p1, p0, n * sizeof(double));
+    return DM_OK;
+  }
+  if (P->explicit_sv) {
+    st = dm_prk_verlet_step(P, h, q0, p0, cont, P->q1w, P->p1w, stt, e);
+  } else {
+    st = predict(P, h, q0, p0, cont, e);
+    if (st == DM_OK && P->m)
+      st = dm_prk_constr_begin(P, q0, e);
+    if (st == DM_OK)
+      st = newton(P, mode, h, q0, p0, NULL, stt, e);
+    if (st == DM_OK && P->m) {
+      st = dm_prk_constr_finish(P, h, q0, p0, P->q1w, P->p1w, e);
+    } else if (st == DM_OK) {
+      /* q1 = q0 + h sum b_i V_i, p1 = p0 + h sum b_i W_i, Kahan-compensated
+       * (the arithmetic of dm_prk_kahan, in one pass) */
+      const double *X = P->X, *W = P->W;
+      double *cq = P->cq, *cp = P->cp, *q1w = P->q1w, *p1w = P->p1w;
+      for (a = 0; a < n; a++) {
+        double sq = 0.0, sp = 0.0, y, t;
+        for (i = 0; i < s; i++) {
+          sq += b[i] * X[i * n + a];
+          sp += b[i] * W[i * n + a];
+        }
+        y = h * sq - cq[a];
+        t = q0[a] + y;
+        cq[a] = (t - q0[a]) - y;
+        q1w[a] = t;
+        y = h * sp - cp[a];
+        t = p0[a] + y;
+        cp[a] = (t - p0[a]) - y;
+        p1w[a] = t;
+      }
+    }
+  }
+  for (a = 0; a < n; a++)
+    bad |= !isfinite(P->q1w[a]) | !isfinite(P->p1w[a]);
+  if (st == DM_OK && bad)
+    st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
+  if (st != DM_OK) {
+    P->hist = 0;
+    P->svf_valid = 0;
+    return st;
+  }
+  /* history: the predictor's stages (and multipliers), continuation test */
+  dm_vcopy(P->hV, P->X, sn);
+  if (P->m)
+    dm_vcopy(P->hx, P->X + sn, nunk(P, DM_PRK_CSTEP) - sn);
+  dm_vcopy(P->hq1, P->q1w, n);
+  dm_vcopy(P->hp1, P->p1w, n);
+  P->hist_h = h;
+  P->hist = 1;
+  dm_vcopy(q1, P->q1w, n);
+  dm_vcopy(p1, P->p1w, n);
+  if (stt)
+    stt->steps++;
+  return DM_OK;
+}
+
+int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
+                    double *DPhi, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, nn = P->nn, N2 = 2 * n, i, j, k, a, c, x;
+  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
+  int st;
+  if (P->m)
+    return dm_err_set(e, DM_EUNSUP, "the step Jacobian is not available for constrained systems");
+  if ((st = dm_prk_step(P, h, q0, p0, DPhi, DPhi + n, stt, e)) != DM_OK)
+    return st;
+  if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, NULL, 1, e)) != DM_OK)
+    return st;
+  if (dm_smalllu_factor(P->Jm, sn, P->perm) != DM_OK)
+    return dm_prk_singular(P, "stage equations", h, e);
+  for (c = 0; c < N2; c++) {
+    double *dV = P->rhs + c * sn;
+    for (i = 0; i < s; i++)
+      for (a = 0; a < n; a++) {
+        double v;
+        if (c < n) {
+          v = P->Lvq[i * nn + a * n + c];
+          for (j = 0; j < s; j++)
+            v -= h * At[i * s + j] * P->D[j * nn + a * n + c];
+        } else {
+          v = (a == c - n) ? -1.0 : 0.0;
+        }
+        dV[i * n + a] = -v;
+      }
+    dm_smalllu_solve(P->Jm, sn, P->perm, dV);
+    /* dQ_j = e_c (q part) + h sum_k a_jk dV_k, stored in Q as scratch */
+    for (j = 0; j < s; j++)
+      for (a = 0; a < n; a++) {
+        double acc = 0.0;
+        for (k = 0; k < s; k++)
+          acc += A[j * s + k] * dV[k * n + a];
+        P->Q[j * n + a] = (c < n && a == c ? 1.0 : 0.0) + h * acc;
+      }
+    for (a = 0; a < n; a++) {
+      double dq1 = 0.0, dp1 = 0.0;
+      for (j = 0; j < s; j++) {
+        double f = 0.0;
+        dq1 += b[j] * dV[j * n + a];
+        for (x = 0; x < n; x++)
+          f += P->D[j * nn + a * n + x] * P->Q[j * n + x] + P->Bm[j * nn + a * n + x] * dV[j * n + x];
+        dp1 += b[j] * f;
+      }
+      DPhi[a * N2 + c] = (c == a ? 1.0 : 0.0) + h * dq1;
+      DPhi[(n + a) * N2 + c] = (c == n + a ? 1.0 : 0.0) + h * dp1;
+    }
+  }
+  return DM_OK;
+}
+
+int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e)
+{
+  if (P->m)
+    return dm_err_set(e, DM_EUNSUP,
+                      "discrete Legendre transforms are not available for constrained systems");
+  if (h == 0.0)
+    return dm_err_set(e, DM_EINVAL, "discrete Legendre transform needs h != 0");
+  return DM_OK;
+}
+
+int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
+                     double *p0, double *p1, double *Ld, dm_integ_stats *stt, dm_err *e)
+{
+  size_t n = P->n, s = P->s, sn = P->sn, i, a;
+  const double *b = P->tab->b;
+  int st = dm_prk_dleg_check(P, h, e);
+  if (st != DM_OK)
+    return st;
+  for (i = 0; i < s; i++)
+    for (a = 0; a < n; a++)
+      P->X[i * n + a] = (q1[a] - q0[a]) / h;
+  memset(P->X + sn, 0, n * sizeof(double));
+  if ((st = newton(P, DM_PRK_DLEG, h, q0, NULL, q1, stt, e)) != DM_OK)
+    return st;
+  if (Ld) {
+    *Ld = 0.0;
+    for (i = 0; i < s; i++)
+      *Ld += h * b[i] * P->Lval[i];
+  }
+  for (a = 0; a < n; a++) {
+    double acc = 0.0;
+    for (i = 0; i < s; i++)
+      acc += b[i] * P->W[i * n + a];
+    P->tmp[a] = P->X[sn + a] + h * acc;
+  }
+  if (p0)
+    memcpy(p0, P->X + sn, n * sizeof(double));
+  if (p1)
+    memcpy(p1, P->tmp, n * sizeof(double));
+  return DM_OK;
+}
+
+/* {==== type-object glue for the PRK families ============================ */
+
+int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
+{
+  dm_prk *P;
+  int st = dm_prk_alloc(I->sys, t, I->opt.tol, I->opt.maxiter, I->opt.explicit_sv, &P, e);
+  if (st != DM_OK)
+    return st;
+  I->state = P;
+  P->simplified = I->opt.simplified;
+  I->order = t->order;
+  I->flags = DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;
+  if (I->m == 0)
+    I->flags |= DM_INTEG_EXACT_JAC;
+  if (t->flags & DM_TAB_SYMPLECTIC)
+    I->flags |= DM_INTEG_SYMPLECTIC;
+  if (t->flags & DM_TAB_SYMMETRIC)
+    I->flags |= DM_INTEG_SYMMETRIC;
+  if (P->explicit_sv)
+    I->flags |= DM_INTEG_EXPLICIT;
+  return DM_OK;
+}
+
+int dm_prk_type_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                     double *q1, double *p1, dm_err *e)
+{
+  return dm_prk_step(I->state, h, q0, p0, q1, p1, &I->stats, e);
+}
+
+int dm_prk_type_jacobian(dm_integrator *I, double h, const double *q0,
+                         const double *p0, double *DPhi, dm_err *e)
+{
+  return dm_prk_jacobian(I->state, h, q0, p0, DPhi, &I->stats, e);
+}
+
+int dm_prk_type_dlegendre(dm_integrator *I, double h, const double *q0,
+                          const double *q1, double *p0, double *p1, double *Ld,
+                          dm_err *e)
+{
+  return dm_prk_dlegendre(I->state, h, q0, q1, p0, p1, Ld, &I->stats, e);
+}
+
+int dm_prk_type_advance(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                        long *done, dm_err *e)
+{
+  dm_prk *P = I->state;
+  long k;
+  int st = DM_OK;
+  if (P->explicit_sv && P->m == 0)
+    return dm_prk_verlet_advance(P, h, NULL, 1, nsteps, q, p, done, &I->stats, e);
+  for (k = 0; k < nsteps; k++) {
+    if (dm_interrupted()) {
+      st = DM_EINTR;
+      break;
+    }
+    if ((st = dm_prk_step(P, h, q, p, q, p, &I->stats, e)) != DM_OK)
+      break;      /* outputs are written only on success */
+  }
+  *done = k;
+  return st;
+}
+
+void dm_prk_type_reset(dm_integrator *I)
+{
+  dm_prk_reset(I->state);
+}
+
+void dm_prk_type_free(dm_integrator *I)
+{
+  dm_prk_free(I->state);
+  I->state = NULL;
+}

@@ -1,0 +1,84 @@
+/* prk_impl.h -- the implicit PRK engine's private state, shared by
+ * prk_engine.c (Newton, predictor, Jacobian, discrete Legendre transforms),
+ * prk_constrained.c (multipliers) and verlet.c (explicit paths). */
+#ifndef DM_PRK_IMPL_H
+#define DM_PRK_IMPL_H
+
+#include "integrators/integ_impl.h"
+
+enum dm_prk_mode {
+  DM_PRK_STEP,      /* unknowns: stage velocities V (s n) */
+  DM_PRK_CSTEP,     /* V, stage multipliers (nK m), initial multiplier mu0 (m) */
+  DM_PRK_DLEG       /* V, p0 (n): boundary problem for given (q0, q1) */
+};
+
+/* Structure of a constant mass matrix (explicit Stormer-Verlet). */
+enum dm_prk_mass { DM_MASS_FULL, DM_MASS_DIAG, DM_MASS_UNIT };
+
+struct dm_prk {
+  const dm_system *sys;
+  dm_tableau *tab;             /* owned copy */
+  size_t n, s, m, sn, nn;
+  int forced;
+  int sep;                     /* separable and unforced: Lvv = M, Lvq = Bm = 0 */
+  int explicit_sv;             /* explicit Stormer-Verlet / RATTLE */
+  int distinct_nodes;          /* predictor may interpolate */
+  double tol;
+  int maxiter;
+  int simplified;              /* reuse the factored Jacobian while converging fast */
+  int njac;                    /* Jacobian factorisations in the last solve */
+  double lvv_norm;             /* max |Lvv| over the stages, set with the Jacobian */
+  /* constraints: multipliers at the stages K (interior stages of a Lobatto
+   * type tableau), plus mu0 on p0 and g(q1) = 0 (see prk_constrained.c) */
+  size_t nK, K[DM_TABLEAU_SMAX];
+  size_t Nmax;
+  double *Jm;                  /* Nmax x Nmax Newton matrix, then its LU */
+  size_t *perm;
+  double *R;                   /* Nmax residual / update */
+  double *X;                   /* Nmax unknowns; V = X[0 .. sn) */
+  double *Q, *Lq, *Lv, *W, *F; /* s n each; W = Lq + F */
+  double *Lvv, *Lvq, *Lqq, *Fq, *Fv, *D, *Bm;  /* s n n each; D = Lqq + Fq, Bm = Lvq^T + Fv */
+  double *Lval;                /* s values of L */
+  double *g, *G, *Hc;          /* constraint values at s + 2 points: stages, q0 (s), q1 (s+1) */
+  double *q1w, *p1w, *v1w, *dq, *dp, *tmp;   /* n each */
+  double *rhs;                 /* Nmax x 2n, Jacobian right-hand sides */
+  /* history: predictor and compensated summation */
+  int hist;
+  double hist_h, E_ratio;
+  double *hV, *hx, *hq1, *hp1; /* sn, Nmax - sn, n, n */
+  double *E;                   /* s x s extrapolation matrix */
+  double *cq, *cp;             /* Kahan carries */
+  /* separable systems */
+  double *Minv;                /* n x n */
+  int mass_kind;               /* DM_MASS_UNIT / _DIAG / _FULL: how M^{-1} applies */
+  double *svf;                 /* Lq at hq1 (first same as last) */
+  int svf_valid;
+  dm_legendre_ws *leg;
+  void *work;
+};
+
+/* prk_engine.c */
+int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e);
+int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e);
+/* DM_OK, or the error of a discrete Legendre transform that cannot be
+ * taken (constrained system, h = 0). */
+int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e);
+
+/* prk_constrained.c */
+int dm_prk_constr_layout(dm_prk *P, dm_err *e);
+int dm_prk_constr_begin(dm_prk *P, const double *q0, dm_err *e);
+int dm_prk_constr_assemble(dm_prk *P, double h, const double *q0, int jac, dm_err *e);
+int dm_prk_constr_finish(dm_prk *P, double h, const double *q0, const double *p0,
+                         double *q1, double *p1, dm_err *e);
+int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
+                            double *p1, const double *vguess, dm_err *e);
+
+/* verlet.c */
+int dm_prk_verlet_setup(dm_prk *P, dm_err *e);
+int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
+                       int cont, double *q1, double *p1, dm_integ_stats *st, dm_err *e);
+/* nsteps steps of ns substeps g[j] h each (g = NULL: plain Stormer-Verlet) */
+int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long nsteps,
+                          double *q, double *p, long *done, dm_integ_stats *st, dm_err *e);
+
+#endif
