@@ -1,7 +1,7 @@
 /* b3_long.c -- B3 long-time energy behaviour, dmech and GSL, in C.
  *
- * Kepler e = 0.6 over P periods (argument; spec T2.6 asks for 10^5 with
- * Stormer-Verlet h = 0.01, 6.3e7 steps).  Methods: dmech Stormer-Verlet
+ * Kepler e = 0.6 over P periods (argument; the full run of doc/integrators.md
+ * §12.5 is 10^5 with Stormer-Verlet h = 0.01, 6.3e7 steps).  Methods: dmech Stormer-Verlet
  * h = 0.01, dmech Gauss s=2 h = 0.05, dmech rk4 h = 0.01 (classical,
  * non-symplectic) on the built-in C system, and GSL rk8pd (adaptive,
  * epsabs = epsrel = 1e-10, driven directly).  For each: the CPU time of an

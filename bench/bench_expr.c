@@ -1,7 +1,7 @@
 /* bench_expr.c -- the expression engine against hand-written C.
  *
- * For the J2 satellite (routh.md section 8, Cartesian) and the double
- * spherical pendulum (section 9, cylindrical, written with cos(th2 - th1)
+ * For the J2 satellite (doc/reduce.md §13, Cartesian) and the double
+ * spherical pendulum (§14, cylindrical, written with cos(th2 - th1)
  * as a person would), evaluate L + gradient + all second derivatives
  * through the dm_system callback three ways -- tape, native code, and
  * hand-derived C of the same formulas -- and print ns per evaluation

@@ -1,4 +1,4 @@
-/* bench_reduce.c -- the double spherical pendulum (spec routh.md 9): cost per
+/* bench_reduce.c -- the double spherical pendulum (doc/reduce.md §14): cost per
  * step and accuracy, at equal h, of
  *   RSPRK on the shape space (r1, r2, phi)       3 dof            (reduced)
  *   SPRK on the unreduced system (r1, th1, r2, phi) 4 dof         (same chart)

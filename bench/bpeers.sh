@@ -1,7 +1,7 @@
 #!/bin/sh
 # bpeers.sh -- run benchmarks B1, B2, B3, B5 against the peers, one after the
 # other (never in parallel: they time CPU), and write the report.
-# Called by `make bench-peers` (bench/peers.am) with:
+# Called by `make bench-peers` (bench/bench.am) with:
 #   SRCDIR BUILDDIR DMECH RESULTS PYTHON B3_PERIODS B3_SCIPY_PERIODS
 # in the environment.  Every missing peer is reported as "skipped".
 # Outputs in $RESULTS: b1.txt, b1_lua.txt, b2_*.tsv, b2_*.txt, b3_*.tsv,

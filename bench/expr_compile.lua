@@ -1,6 +1,6 @@
 -- expr_compile.lua -- trace + differentiate + compile (tape) of the double
 -- spherical pendulum through the Lua API, as a user pays for it: the
--- Lagrangian of routh.md section 9 in cylindrical coordinates with the
+-- Lagrangian of doc/reduce.md §14 in cylindrical coordinates with the
 -- bobs' Cartesian velocities written out, its gradient and full Hessian in
 -- (q, v), compiled with dm.fn.  Every repetition uses fresh symbol names,
 -- so nothing is reused from earlier ones.  Target: under 20 ms.

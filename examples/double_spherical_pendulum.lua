@@ -10,7 +10,7 @@
 -- (q1 = first bob from the pivot, q2 = second bob from the first).
 -- dm.routh reduces by theta (the simultaneous rotation): locked inertia
 -- I = m1 r1^2 + m2 (r1^2 + r2^2 + 2 r1 r2 cos phi), connection A, magnetic
--- 2-form beta (spec routh.md 9).  Initial condition: r1 = 0.67, r2 = 0.36,
+-- 2-form beta (doc/reduce.md §14).  Initial condition: r1 = 0.67, r2 = 0.36,
 -- phi = 0.68, thetadot = 1.2, r1dot = -0.22, r2dot = 0.24, phidot = -0.61 (a
 -- motion whose bobs pass close to the vertical axis, r2 down to ~0.03).
 --

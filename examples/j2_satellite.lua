@@ -6,8 +6,8 @@
 --
 -- The reduction is derived by dmech itself: dm.routh(sys, {cyclic = {"theta"}})
 -- finds the locked inertia r^2, the connection A = 0, beta = 0 and the
--- Routhian R = (rdot^2 + zdot^2)/2 - V(r, z) - mu^2/(2 r^2) (spec routh.md 8,
--- with the corrected sign of the Kepler term and the centrifugal term).  The
+-- Routhian R = (rdot^2 + zdot^2)/2 - V(r, z) - mu^2/(2 r^2) (doc/reduce.md
+-- §13, with the corrected sign of the Kepler term and the centrifugal term).  The
 -- reduced system is integrated on (r, z) (RSPRK), and the 3-D orbit is
 -- reconstructed from it (theta advanced by the reduced integrator's group
 -- increments).

@@ -9,7 +9,7 @@ local dm = dm or require "dmech"
 local outdir = arg and arg[1] or "."
 
 -- {== the data: Stoermer-Verlet for a satellite in the J2 field ===========
---   V = -1/R + J2/R^3 (3/2 z^2/R^2 - 1/2)   (DESIGN.md section 4)
+--   V = -1/R + J2/R^3 (3/2 z^2/R^2 - 1/2)   (doc/reduce.md §13)
 local J2 = 0.05
 local function accel(x, y, z)
   local R2 = x * x + y * y + z * z

@@ -1,5 +1,5 @@
 // odeint_bench.cpp -- Boost.Odeint peers for B2 and B3 (C++, header-only
-// Boost; compiled by bench/peers.am only when the headers exist).
+// Boost; compiled by bench/bench.am only when the headers exist).
 //
 //   odeint_bench workprec <kepler|j2|all> <outdir> <reference.txt>
 //     velocity_verlet (order 2), symplectic_rkn_sb3a_m4_mclachlan (order 4,

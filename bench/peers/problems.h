@@ -1,11 +1,11 @@
 /* problems.h -- the two benchmark problems written by hand (shared by the C
  * harnesses bench/b*.c and the C++ harness bench/peers/odeint_bench.cpp).
  *
- * Kepler e = 0.6 (spec galerkin.md T2.6): L = |v|^2/2 + 1/|q|, n = 2,
+ * Kepler e = 0.6 (doc/integrators.md §12.5): L = |v|^2/2 + 1/|q|, n = 2,
  *   q0 = (0.4, 0), p0 = (0, 2), H0 = -1/2, period 2 pi.
- * J2 satellite, Cartesian (spec routh.md section 8, corrected potential):
+ * J2 satellite, Cartesian (doc/reduce.md §13, corrected potential):
  *   V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2), J2 = 0.05 (the thesis's
- *   value), q0 = (2, 0, 0.3), p0 = (0, 0.6, 0.1) (the DESIGN example),
+ *   value), q0 = (2, 0, 0.3), p0 = (0, 0.6, 0.1) (the example of plot_gallery.lua),
  *   osculating period about 12.7; "1000 orbits" = T = 12750.
  * Unit mass: p = v.  Everything is static inline; no allocation.
  */

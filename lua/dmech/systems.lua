@@ -64,7 +64,7 @@ return function(dm)
     end)
 
   def("pendulum", "dm.systems.pendulum{g=9.81, l=1, m=1} -> system",
-    "Planar pendulum, angle theta from the downward vertical: L = m l^2 thetadot^2/2 + m g l cos(theta) (g = l = m = 1 is the test problem of spec T2.2).",
+    "Planar pendulum, angle theta from the downward vertical: L = m l^2 thetadot^2/2 + m g l cos(theta).",
     function(o)
       local p = params("pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
       return dm.system{name = "pendulum", coords = {"theta"}, params = p,
@@ -98,14 +98,15 @@ return function(dm)
         end}
     end)
 
-  -- the corrected J2 potential of spec routh.md section 8
+  -- the J2 potential of thesis §2.9 with the sign of its Kepler term corrected
+  -- (doc/reduce.md §13)
   local function j2_potential(R2, z, J2)
     local R = dm.sqrt(R2)
     return -1 / R + J2 / R^3 * (1.5 * z^2 / R2 - 0.5)
   end
 
   def("j2", "dm.systems.j2{J2=0.05} -> system",
-    "J2 satellite in Cartesian (x, y, z), non-dimensional (Earth radius 1): L = |v|^2/2 - V, V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (the corrected potential of spec routh.md 8); the z angular momentum is conserved.",
+    "J2 satellite in Cartesian (x, y, z), non-dimensional (Earth radius 1): L = |v|^2/2 - V, V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (thesis §2.9, with the sign of the printed Kepler term corrected); the z angular momentum is conserved.",
     function(o)
       local p = params("j2", o, {{"J2", 0.05}})
       return dm.system{name = "J2 satellite (Cartesian)", coords = {"x", "y", "z"}, params = p,
@@ -169,7 +170,7 @@ return function(dm)
 
   def("double_spherical_pendulum",
     "dm.systems.double_spherical_pendulum{g=9.81, l1=1, l2=1, m1=1, m2=1, form=\"cylindrical\"|\"shape\"} -> system",
-    "Double spherical pendulum (spec routh.md 9) in cylindrical coordinates of each bob relative to its pivot, hanging below (z_i = -sqrt(l_i^2 - r_i^2)): coords r1, theta1, r2, theta2, or with form=\"shape\" theta, r1, r2, phi (theta1 = theta, theta2 = theta + phi; theta cyclic for the simultaneous rotation). L = m1|q1dot|^2/2 + m2|q1dot + q2dot|^2/2 - m1 g z1 - m2 g (z1 + z2), written through phi = theta2 - theta1 only.",
+    "Double spherical pendulum (thesis §2.10) in cylindrical coordinates of each bob relative to its pivot, hanging below (z_i = -sqrt(l_i^2 - r_i^2)): coords r1, theta1, r2, theta2, or with form=\"shape\" theta, r1, r2, phi (theta1 = theta, theta2 = theta + phi; theta cyclic for the simultaneous rotation). L = m1|q1dot|^2/2 + m2|q1dot + q2dot|^2/2 - m1 g z1 - m2 g (z1 + z2), written through phi = theta2 - theta1 only.",
     function(o)
       local p, ex = params("double_spherical_pendulum", o, dsp_params, {"form"})
       local shape = (ex.form or "cylindrical") == "shape"
@@ -200,7 +201,7 @@ return function(dm)
 
   def("double_spherical_pendulum_r3",
     "dm.systems.double_spherical_pendulum_r3{g=9.81, l1=1, l2=1, m1=1, m2=1} -> system",
-    "Double spherical pendulum in R^3 x R^3 (coords x1, y1, z1 of the first bob from the pivot, x2, y2, z2 of the second from the first) with the constraints |q1| - l1 = 0, |q2| - l2 = 0 (spec routh.md 9, constrained variant).",
+    "Double spherical pendulum in R^3 x R^3 (coords x1, y1, z1 of the first bob from the pivot, x2, y2, z2 of the second from the first) with the constraints |q1| - l1 = 0, |q2| - l2 = 0 (thesis §2.10.4).",
     function(o)
       local p = params("double_spherical_pendulum_r3", o, dsp_params)
       return dm.system{name = "double spherical pendulum (R3xR3)", params = p,

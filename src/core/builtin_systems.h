@@ -17,14 +17,14 @@
 /* L = 1/2 v^2 - 1/2 omega^2 q^2 (n = 1; par: omega). Separable. */
 int dm_builtin_harmonic(dm_system *s, double omega, dm_err *e);
 
-/* L = 1/2 v^2 + k cos q (n = 1; par: k = g/l; spec T2.2 uses k = 1). Separable. */
+/* L = 1/2 v^2 + k cos q (n = 1; par: k = g/l; k = 1 in doc/integrators.md §12). Separable. */
 int dm_builtin_pendulum(dm_system *s, double k, dm_err *e);
 
 /* Kepler problem in dim = 2 or 3 Cartesian coordinates:
  * L = 1/2 |v|^2 + mu / |q| (par: mu). Separable. */
 int dm_builtin_kepler(dm_system *s, int dim, double mu, dm_err *e);
 
-/* J2 satellite, Cartesian (x, y, z), non-dimensional (spec routh.md §8, the
+/* J2 satellite, Cartesian (x, y, z), non-dimensional (doc/reduce.md §13, the
  * corrected potential):
  *   V = -1/|q| + (J2/|q|^3) (3 z^2 / (2 |q|^2) - 1/2),  L = 1/2 |v|^2 - V.
  * (par: J2). Separable. */

@@ -2,7 +2,7 @@
  * of the integrators and the reduction (stage equations, SHAKE, momentum
  * projections, Legendre maps: n from 1 to about a hundred).
  *
- * Why not GSL here.  STYLE.md asks for GSL's linear algebra; small kernels
+ * Why not GSL here.  The project uses GSL's linear algebra; small kernels
  * are the exception when measured.  GSL 2.7's gsl_linalg_LU_decomp is the
  * blocked (level-3) algorithm: for a 6 x 6 system it goes through views,
  * cblas_dtrsv/dger/idamax calls and mallocs and frees a pivot vector on

@@ -6,7 +6,7 @@
  *   Q_i = q0 + h sum_j a_ij Qdot_j,   P_i = p0 + h sum_j at_ij Pdot_j,
  *   q1  = q0 + h sum_j b_j Qdot_j,    p1  = p0 + h sum_j bt_j Pdot_j.
  *
- * Galerkin tableaus (spec galerkin.md §2, thesis eq. 2.4.3) come from s
+ * Galerkin tableaus (doc/integrators.md §4, thesis eq. 2.4.3) come from s
  * quadrature nodes: b_i = int_0^1 l_i, a_ij = int_0^{c_i} l_j,
  * at_ij = b_j (1 - a_ji / b_i), bt = b.  Gauss nodes are taken from GSL
  * (gsl_integration_glfixed_table), Lobatto nodes are computed here

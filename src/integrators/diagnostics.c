@@ -1,4 +1,4 @@
-/* diagnostics.c -- structure checks offered as functions (spec routh.md §7):
+/* diagnostics.c -- structure checks offered as functions (doc/integrators.md §11):
  * step Jacobian and symplecticity defect, time reversal, empirical order. */
 #include <config.h>
 #include "integrators/integ_impl.h"

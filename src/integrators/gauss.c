@@ -1,5 +1,5 @@
 /* gauss.c -- midpoint (Gauss s=1) and Gauss-Legendre Galerkin integrators
- * (spec galerkin.md §2): order 2s, symmetric, symplectic, conserve every
+ * (doc/integrators.md §4): order 2s, symmetric, symplectic, conserve every
  * quadratic invariant the Lagrangian respects.  The step is the implicit
  * PRK of prk_engine.c on the Gauss table of tableau.c.
  *

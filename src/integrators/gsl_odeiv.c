@@ -7,7 +7,7 @@
  * tolerances); the stepper stays attached to a driver, whose tolerances
  * epsabs/epsrel the implicit and multistep steppers use internally.
  * Option adaptive = true integrates each h with gsl_odeiv2_driver_apply;
- * the multistep msadams and msbdf require it.  Note (spec T2.7): rk4imp with a fixed step
+ * the multistep msadams and msbdf require it.  Note (doc/integrators.md §13): rk4imp with a fixed step
  * h takes two Gauss-2 steps of h/2 (step doubling); its internal Newton
  * uses the driver tolerances.  The step Jacobian is not available in closed
  * form (finite differences are used by the diagnostics). */

@@ -1,5 +1,5 @@
 /* lobatto.c -- trapezoid (Lobatto IIIA-IIIB s=2) and Lobatto IIIA-IIIB
- * Galerkin integrators (spec galerkin.md §2): order 2s-2, symmetric,
+ * Galerkin integrators (doc/integrators.md §4): order 2s-2, symmetric,
  * symplectic.  For separable unforced L the s=2 step is explicit
  * Stormer-Verlet (RATTLE with constraints; verlet.c); otherwise the implicit
  * PRK engine.  With constraints every stage point lies on g(q) = 0

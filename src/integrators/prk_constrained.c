@@ -1,5 +1,5 @@
 /* prk_constrained.c -- holonomic constraints g(q) = 0 (m of them) in the
- * implicit PRK step: Lagrange multipliers at the stages (spec routh.md §6,
+ * implicit PRK step: Lagrange multipliers at the stages (doc/integrators.md §10,
  * thesis §2.8; Jay's Lobatto IIIA-IIIB SPARK form for index-3 mechanics).
  *
  * Formulation.  With the augmented Lagrangian L - lambda^T g, the stage

@@ -1,10 +1,10 @@
 /* prk_engine.c -- implicit symplectic PRK step for a Lagrangian system.
  *
- * Unknowns are the s stage velocities V_i = Qdot_i (spec routh.md §3):
+ * Unknowns are the s stage velocities V_i = Qdot_i (doc/integrators.md §6):
  *   Q_i = q0 + h sum_j a_ij V_j,
  *   R_i = Lv(Q_i, V_i) - p0 - h sum_j at_ij W_j = 0,   W_j = Lq(Q_j, V_j) + F(Q_j, V_j)
  *   q1 = q0 + h sum_j b_j V_j,   p1 = p0 + h sum_j b_j W_j
- * (W includes the generalized force: discrete Lagrange-d'Alembert, spec §6).
+ * (W includes the generalized force: discrete Lagrange-d'Alembert, doc/integrators.md §9).
  * Newton uses the exact Jacobian
  *   dR_i/dV_k = d_ik Lvv_i + h a_ik Lvq_i - h at_ik (Lvq_k^T + Fv_k)
  *               - h^2 sum_j at_ij a_jk (Lqq_j + Fq_j),

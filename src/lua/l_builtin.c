@@ -160,7 +160,7 @@ static const dm_reg builtin_funcs[] = {
   {"harmonic", b_harmonic, "dm.builtin.harmonic{omega=1} -> system",
    "Harmonic oscillator L = v^2/2 - omega^2 q^2/2 written in C."},
   {"pendulum", b_pendulum, "dm.builtin.pendulum{k=1} -> system",
-   "Pendulum L = v^2/2 + k cos q (k = g/l) written in C (spec T2.2 uses k = 1)."},
+   "Pendulum L = v^2/2 + k cos q (k = g/l) written in C."},
   {"kepler", b_kepler, "dm.builtin.kepler{dim=2, mu=1} -> system",
    "Kepler problem L = |v|^2/2 + mu/|q| in 2 or 3 Cartesian coordinates, written in C."},
   {"j2", b_j2, "dm.builtin.j2{J2=0.05} -> system",

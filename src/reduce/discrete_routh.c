@@ -1,5 +1,5 @@
-/* discrete_routh.c -- discrete Routh reduction (thesis §2.3.2-2.3.4, spec
- * routh.md §4) for the midpoint and the Galerkin discrete Lagrangians of
+/* discrete_routh.c -- discrete Routh reduction (thesis §2.3.2-2.3.4,
+ * doc/reduce.md §6-8) for the midpoint and the Galerkin discrete Lagrangians of
  * the full system, in the additive coordinates q = (theta, x):
  *   psi_mu(x0, x1): J_d((0, x0), (psi, x1)) = mu, J_d = D2 L_d along theta;
  *     midpoint: psi = h I(xbar)^{-1} mu - A(xbar)(x1 - x0) (linear, no

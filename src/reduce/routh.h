@@ -1,5 +1,5 @@
 /* routh.h -- automatic Routh reduction by cyclic coordinates (thesis ch. 2,
- * spec routh.md §1, §4-6): the reduced objects derived symbolically, the
+ * doc/reduce.md): the reduced objects derived symbolically, the
  * reduced integrators (RSPRK, discrete Routh equations, classical Routhian
  * SPRK), projection, reconstruction and geometric phases.
  *
@@ -217,12 +217,12 @@ const char *dm_routh_integrator_kind(const dm_integrator *I);
 
 /* Non-canonical symplecticity defect of one step at (x0, s0):
  * max |DPhi^T W(x1) DPhi - W(x0)| / max(1, max |W(x0)|) with
- * W(x) = [[-B(x), Id], [-Id, 0]] (spec §5 item 4).  DPhi exact for RSPRK and
+ * W(x) = [[-B(x), Id], [-Id, 0]] (doc/reduce.md §10).  DPhi exact for RSPRK and
  * classical, central differences for DR.  Not for constrained systems. */
 int dm_routh_symplecticity_defect(dm_integrator *I, double h, const double *x0,
                                   const double *s0, double *defect, dm_err *e);
 
-/* {==== discrete Routh equations (spec §4) ============================= */
+/* {==== discrete Routh equations (doc/reduce.md §7) ========================= */
 
 typedef struct dm_routh_dr dm_routh_dr;
 

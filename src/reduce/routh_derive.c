@@ -1,7 +1,7 @@
 /* routh_derive.c -- symbolic Routh reduction: from L(q, v) and the cyclic
  * coordinates to the locked inertia, mechanical connection, amended
- * potential, Routhians and magnetic 2-form as expression nodes (spec
- * routh.md §1).  See routh.h for what is derived and the error rules.
+ * potential, Routhians and magnetic 2-form as expression nodes (doc/reduce.md
+ * §2-3).  See routh.h for what is derived and the error rules.
  *
  * Inverse of the locked inertia: symbolic, by the adjugate over the
  * determinant, for r <= 3 (r > 3 is DM_EUNSUP): it keeps every derived

@@ -1,5 +1,5 @@
 /* rsprk.c -- the reduced symplectic partitioned Runge-Kutta method (thesis
- * §2.5, eq. 2.5.14; spec routh.md §5) on T*S with state (x, s),
+ * §2.5, eq. 2.5.14; doc/reduce.md §9) on T*S with state (x, s),
  * s = dR/dxdot, implemented directly from its equations:
  *   X_i = x0 + h sum_j a_ij Xd_j
  *   S_i = s0 + h sum_j at_ij Sd_j + [h sum_j at_ij K_j Xd_j - (muA(X_i) - muA(x0))]

@@ -1,5 +1,5 @@
 /* rsprk_constr.c -- holonomic constraints ghat(y) = 0 on the preshape space
- * in the RSPRK step (thesis §2.8, Theorems 2.14 / 2.17; spec routh.md §6),
+ * in the RSPRK step (thesis §2.8, Theorems 2.14 / 2.17; doc/reduce.md §11),
  * with the multiplier layout of src/integrators/prk_constrained.c and
  * its kernels (prk_kernels.h: stages, residual/Jacobian terms, impulses):
  * unknowns (Xd_i, Lt_k for the interior stages k of a Lobatto-type tableau,

@@ -1,5 +1,5 @@
 /* reduce_systems.h -- test systems of the Routh reduction tests, built as
- * expressions (spec routh.md §8-9):
+ * expressions (doc/reduce.md §13-14):
  *   J2 satellite in cylindrical coordinates (r, theta, z), param J2;
  *   double spherical pendulum in cylindrical coordinates with the bobs
  *   hanging below (r1, theta1, r2, phi), phi = theta2 - theta1, params

@@ -112,7 +112,7 @@ int main(void)
   dm_builtin_j2(&s, 0.05, NULL);
   tap_ok(check_lag(&s, q3, v3) < 1e-8, "J2 derivatives (%.2g)", check_lag(&s, q3, v3));
   {
-    /* V = -1/r + (J2/r^3)(3 z^2/(2 r^2) - 1/2) at q3: spec routh.md §8 */
+    /* V = -1/r + (J2/r^3)(3 z^2/(2 r^2) - 1/2) at q3: doc/reduce.md §13 */
     double r = sqrt(1.1 * 1.1 + 0.7 * 0.7 + 0.45 * 0.45);
     double V = -1 / r + 0.05 / (r * r * r) * (1.5 * 0.45 * 0.45 / (r * r) - 0.5);
     double T = 0.5 * (0.09 + 0.81 + 0.04);

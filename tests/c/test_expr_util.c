@@ -44,7 +44,7 @@ const char *const tx_exprs[] = {
 };
 const size_t tx_nexprs = sizeof tx_exprs / sizeof tx_exprs[0];
 
-/* The double spherical pendulum (routh.md section 9) in cylindrical
+/* The double spherical pendulum (doc/reduce.md §14) in cylindrical
  * coordinates q = (r1, th1, r2, th2), velocities (vr1, vth1, vr2, vth2),
  * parameters (pm1, pm2, pl1, pl2, pg): Cartesian velocities of the bobs
  * written out, z_i = -sqrt(l_i^2 - r_i^2). */
@@ -60,7 +60,7 @@ const char *const tx_dsp_q[4] = { "r1", "th1", "r2", "th2" };
 const char *const tx_dsp_v[4] = { "vr1", "vth1", "vr2", "vth2" };
 const char *const tx_dsp_par[5] = { "pm1", "pm2", "pl1", "pl2", "pg" };
 
-/* The J2 satellite (routh.md section 8), Cartesian: q = (x, y, z),
+/* The J2 satellite (doc/reduce.md §13), Cartesian: q = (x, y, z),
  * v = (vx, vy, vz), parameter pJ2; L = |v|^2/2 - V with
  * V = -1/R + J2/R^3 (1.5 z^2/R^2 - 0.5). */
 const char tx_j2_lagrangian[] =

@@ -52,7 +52,7 @@ static void orders(void)
     st = dm_integrator_order_estimate(&s, "composition", &o, &q0, &p0, cases[i].T, cases[i].h,
                                       cases[i].k, NULL, NULL, err, &ord, NULL);
     tap_ok(st == DM_OK && fabs(ord - cases[i].order) <= 0.1,
-           "T2.3 composition %s: order %.3f (want %d), errors %.3e .. %.3e", cases[i].scheme, ord,
+           "pendulum order, composition %s: order %.3f (want %d), errors %.3e .. %.3e", cases[i].scheme, ord,
            cases[i].order, err[0], err[cases[i].k - 1]);
   }
   {

@@ -1,4 +1,4 @@
-/* test_integrators_kepler.c -- spec T2.6: Kepler e = 0.6 (q0 = (0.4, 0),
+/* test_integrators_kepler.c -- doc/integrators.md §12.5: Kepler e = 0.6 (q0 = (0.4, 0),
  * p0 = (0, 2), H = -1/2, angular momentum 0.8, period 2 pi): energy error
  * maxima over 10 periods for Stormer-Verlet and Gauss 1-3, no drift over
  * 1000 periods (linear fit of the per-period maxima), angular momentum to
@@ -61,11 +61,11 @@ static void maxima(void)
     dm_integrator_new(&s, c[i].m, &o, &I, NULL);
     st = dm_integrator_run(I, 0.0, q, p, c[i].h, n, 1, sink, &m, &info, NULL);
     tap_ok(st == DM_OK && m.n == n + 1 && fabs(m.dH / c[i].want - 1.0) <= 0.05,
-           "T2.6 %s%s h = %g: max |H - H0| over 10 periods %.4g (spec %.4g)",
+           "Kepler %s%s h = %g: max |H - H0| over 10 periods %.4g (reference %.4g)",
            c[i].m, c[i].s ? (c[i].s == 1 ? " s=1" : c[i].s == 2 ? " s=2" : " s=3") : " (Stormer-Verlet)",
            c[i].h, m.dH, c[i].want);
     if (strcmp(c[i].m, "gauss") == 0 && c[i].s == 2)
-      tap_ok(m.dJ <= 5e-13, "T2.6 G2 h = %g: angular momentum error %.2g (quadratic invariant)", c[i].h, m.dJ);
+      tap_ok(m.dJ <= 5e-13, "Kepler G2 h = %g: angular momentum error %.2g (quadratic invariant)", c[i].h, m.dJ);
     dm_integrator_free(I);
   }
   dm_system_release(&s);
@@ -103,12 +103,12 @@ static void long_run(void)
   }
   slope = (NP * sxy - sx * sy) / (NP * sxx - sx * sx);
   mean = sy / NP;
-  tap_ok(st == DM_OK && (I->flags & DM_INTEG_EXPLICIT), "T2.6 %ld explicit Stormer-Verlet steps", n);
-  tap_ok(fabs(all / 3.707e-4 - 1.0) <= 0.05, "T2.6 SV h = 0.01 over 1000 periods: max |H - H0| %.4g (spec 3.707e-4)", all);
+  tap_ok(st == DM_OK && (I->flags & DM_INTEG_EXPLICIT), "Kepler: %ld explicit Stormer-Verlet steps", n);
+  tap_ok(fabs(all / 3.707e-4 - 1.0) <= 0.05, "Kepler SV h = 0.01 over 1000 periods: max |H - H0| %.4g (reference 3.707e-4)", all);
   tap_ok(fabs(slope * NP) <= 1e-3 * mean,
-         "T2.6 no drift: trend of the per-period maxima over 1000 periods %.2g (mean maximum %.4g)",
+         "Kepler no drift: trend of the per-period maxima over 1000 periods %.2g (mean maximum %.4g)",
          slope * NP, mean);
-  tap_ok(dJ <= 5e-13, "T2.6 angular momentum error after 1000 periods %.2g", dJ);
+  tap_ok(dJ <= 5e-13, "Kepler angular momentum error after 1000 periods %.2g", dJ);
   dm_integrator_free(I);
   dm_system_release(&s);
 }

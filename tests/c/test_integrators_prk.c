@@ -1,6 +1,7 @@
-/* test_integrators_prk.c -- Gauss and Lobatto (Galerkin PRK) integrators:
- * spec T2.2 one-step values, T2.3 orders, T2.5 harmonic oscillator, T2.8
- * time reversal, symplecticity defect, discrete Legendre transforms / DEL
+/* test_integrators_prk.c -- Gauss and Lobatto (Galerkin PRK) integrators on
+ * the reference problems of doc/integrators.md §12: the pendulum's one-step
+ * values and orders, the analytic pendulum, the harmonic oscillator, Kepler
+ * time reversal; symplecticity defect, discrete Legendre transforms / DEL
  * form / discrete momentum, non-separable and forced systems. */
 #include <config.h>
 #include <math.h>
@@ -24,8 +25,8 @@ static dm_integrator *make(const dm_system *s, const char *method, int stages, i
   return I;
 }
 
-/* T2.2: one step of the pendulum L = v^2/2 + cos q from (1, 0.5), h = 0.1 */
-static void t22(void)
+/* One step of the pendulum L = v^2/2 + cos q from (1, 0.5), h = 0.1 */
+static void pendulum_one_step(void)
 {
   static const struct {
     const char *m;
@@ -51,7 +52,7 @@ static void t22(void)
     dm_err e;
     int st = I ? dm_integrator_step(I, 0.1, &q, &p, &q, &p, &e) : DM_EFAILED;
     tap_ok(st == DM_OK && fabs(q - ref[i].q1) <= 1e-13 && fabs(p - ref[i].p1) <= 1e-13,
-           "T2.2 %s s=%d%s: q1 %.3g, p1 %.3g off (%s, %d Newton iterations)", ref[i].m, ref[i].s,
+           "pendulum one step %s s=%d%s: q1 %.3g, p1 %.3g off (%s, %d Newton iterations)", ref[i].m, ref[i].s,
            ref[i].expl ? "" : " (Newton path)", q - ref[i].q1, p - ref[i].p1,
            I && (I->flags & DM_INTEG_EXPLICIT) ? "explicit" : "implicit", I ? I->stats.iters : -1);
     dm_integrator_free(I);
@@ -59,9 +60,9 @@ static void t22(void)
   dm_system_release(&s);
 }
 
-/* T2.3: orders by step halving; pendulum to T = 2 against the exact value
+/* Orders by step halving; pendulum to T = 2 against the exact value
  * (or T = 10 against a Gauss-6 reference for order 8). */
-static void t23(void)
+static void pendulum_orders(void)
 {
   static const struct {
     const char *m;
@@ -90,17 +91,17 @@ static void t23(void)
                                       cases[i].T == 2 ? &qx : NULL, cases[i].T == 2 ? &px : NULL,
                                       err, &ord, &e);
     tap_ok(st == DM_OK && fabs(ord - cases[i].order) <= 0.1,
-           "T2.3 %s s=%d: order %.3f (want %d), errors %.3e .. %.3e", cases[i].m, cases[i].s, ord,
+           "pendulum order %s s=%d: order %.3f (want %d), errors %.3e .. %.3e", cases[i].m, cases[i].s, ord,
            cases[i].order, err[0], err[cases[i].k - 1]);
     if (i == 0)
-      tap_ok(fabs(err[1] - 9.401e-4) < 5e-8, "T2.3 G1 error at n = 20 is 9.401e-4 (got %.4e)", err[1]);
+      tap_ok(fabs(err[1] - 9.401e-4) < 5e-8, "pendulum G1 error at n = 20 is 9.401e-4 (got %.4e)", err[1]);
   }
   dm_system_release(&s);
 }
 
-/* T2.4: q(0) = 0, p(0) = 2k has q = 2 asin(k sn(t|k^2)), p = 2k cn(t|k^2);
+/* The analytic pendulum: q(0) = 0, p(0) = 2k has q = 2 asin(k sn(t|k^2)), p = 2k cn(t|k^2);
  * k = 1/2, t = 10, h = 0.1: signed errors in q of G1, G2, L2. */
-static void t24(void)
+static void pendulum_analytic(void)
 {
   static const struct {
     const char *m;
@@ -113,23 +114,23 @@ static void t24(void)
   size_t i;
   gsl_sf_elljac_e(10.0, 0.25, &sn, &cn, &dn);
   tap_ok(fabs(2 * asin(0.5 * sn) - qx) < 1e-13 && fabs(cn - px) < 1e-13,
-         "T2.4 reference q(10), p(10) from GSL elljac (%.2g, %.2g)", 2 * asin(0.5 * sn) - qx, cn - px);
+         "analytic pendulum: reference q(10), p(10) from GSL elljac (%.2g, %.2g)", 2 * asin(0.5 * sn) - qx, cn - px);
   dm_builtin_pendulum(&s, 1.0, NULL);
   for (i = 0; i < sizeof c / sizeof c[0]; i++) {
     dm_integrator *I = make(&s, c[i].m, c[i].s, 1);
     double q = 0.0, p = 1.0;
     int st = dm_integrator_run(I, 0.0, &q, &p, 0.1, 100, 100, NULL, NULL, NULL, NULL);
     tap_ok(st == DM_OK && fabs((q - qx) / c[i].err - 1.0) < 0.01,
-           "T2.4 %s s=%d h = 0.1: error in q(10) %.4g (spec %.3g)", c[i].m, c[i].s, q - qx, c[i].err);
+           "analytic pendulum %s s=%d h = 0.1: error in q(10) %.4g (reference %.3g)", c[i].m, c[i].s, q - qx, c[i].err);
     dm_integrator_free(I);
   }
   dm_system_release(&s);
 }
 
-/* T2.5: Gauss s rotates (omega q, p) by 2 arg P_s(i h omega) per step;
+/* The harmonic oscillator: Gauss s rotates (omega q, p) by 2 arg P_s(i h omega) per step;
  * energy conserved to round-off; Stormer-Verlet has trace 2 - (h omega)^2
  * and is unstable for h omega > 2. */
-static void t25(void)
+static void harmonic_phase(void)
 {
   const double w = 2.385, h = 0.1, z = h * w;
   /* numerators of the (s, s) Pade approximants of exp at i z */
@@ -150,7 +151,7 @@ static void t25(void)
     ang = atan2(p, w * q) - atan2(-0.31, w * 0.7);
     ang = remainder(ang + 1000 * th, 2 * M_PI);
     tap_ok(fabs(ang) < 1e-12 && fabs(E - E0) < 1e-14 * 1000 * E0,
-           "T2.5 gauss s=%d: phase after 1000 steps off by %.2g rad, energy error %.2g", sg, ang,
+           "harmonic oscillator gauss s=%d: phase after 1000 steps off by %.2g rad, energy error %.2g", sg, ang,
            (E - E0) / E0);
     dm_integrator_free(I);
   }
@@ -159,17 +160,17 @@ static void t25(void)
     double D[4], q = 0.7, p = -0.31;
     int k;
     dm_integrator_jacobian(I, h, &q, &p, D, NULL);
-    tap_near(D[0] + D[3], 2.0 - z * z, 1e-14, "T2.5 Stormer-Verlet trace %.15g = 2 - (h w)^2", D[0] + D[3]);
+    tap_near(D[0] + D[3], 2.0 - z * z, 1e-14, "harmonic oscillator Stormer-Verlet trace %.15g = 2 - (h w)^2", D[0] + D[3]);
     for (k = 0; k < 200; k++)
       dm_integrator_step(I, 2.1 / w, &q, &p, &q, &p, NULL);
-    tap_ok(fabs(q) > 1e3, "T2.5 Stormer-Verlet unstable at h w = 2.1 (|q| = %.3g after 200 steps)", fabs(q));
+    tap_ok(fabs(q) > 1e3, "harmonic oscillator Stormer-Verlet unstable at h w = 2.1 (|q| = %.3g after 200 steps)", fabs(q));
     dm_integrator_free(I);
   }
   dm_system_release(&s);
 }
 
-/* T2.8: n steps with h then n with -h return to the start (Kepler e = 0.6). */
-static void t28(void)
+/* Time reversal: n steps with h then n with -h return to the start (Kepler e = 0.6). */
+static void kepler_reversal(void)
 {
   static const struct {
     const char *m;
@@ -184,7 +185,7 @@ static void t28(void)
     dm_integrator *I = make(&s, ms[i].m, ms[i].s, ms[i].expl);
     double dev = NAN;
     int st = dm_integrator_reversal(I, 0.05, 200, q0, p0, &dev, NULL);
-    tap_ok(st == DM_OK && dev <= 1e-12, "T2.8 %s s=%d%s: back-and-forth deviation %.2g", ms[i].m,
+    tap_ok(st == DM_OK && dev <= 1e-12, "Kepler reversal %s s=%d%s: back-and-forth deviation %.2g", ms[i].m,
            ms[i].s, ms[i].expl ? "" : " (Newton)", dev);
     dm_integrator_free(I);
   }
@@ -350,11 +351,11 @@ static void nonseparable_and_forced(void)
 int main(void)
 {
   dm_gsl_init();
-  t22();
-  t23();
-  t24();
-  t25();
-  t28();
+  pendulum_one_step();
+  pendulum_orders();
+  pendulum_analytic();
+  harmonic_phase();
+  kepler_reversal();
   defects();
   del_view();
   nonseparable_and_forced();

@@ -74,7 +74,7 @@ static void rk4(void)
   dm_system_release(&pen);
 }
 
-/* T2.7: gsl rk4imp with fixed h is two Gauss-2 steps of h/2. */
+/* doc/integrators.md §13: gsl rk4imp with fixed h is two Gauss-2 steps of h/2. */
 static void gsl_crosscheck(void)
 {
   dm_system pen;
@@ -95,9 +95,9 @@ static void gsl_crosscheck(void)
     st = dm_integrator_step(R, 0.1, &qr, &pr, &qr, &pr, &e);
   for (k = 0; k < 40; k++)
     dm_integrator_step(G2, 0.05, &qg, &pg, &qg, &pg, NULL);
-  tap_ok(fabs(qg - 0.29104536341722818) < 1e-14, "T2.7 G2 h = 0.05, 40 steps: q = %.17g", qg);
+  tap_ok(fabs(qg - 0.29104536341722818) < 1e-14, "rk4imp cross-check: G2 h = 0.05, 40 steps: q = %.17g", qg);
   tap_ok(st == DM_OK && fabs(qr - qg) < 5e-11,
-         "T2.7 gsl:rk4imp h = 0.1 (epsabs 1e-8) matches G2 with h/2: q = %.17g (diff %.2g)", qr, qr - qg);
+         "rk4imp cross-check: gsl:rk4imp h = 0.1 (epsabs 1e-8) matches G2 with h/2: q = %.17g (diff %.2g)", qr, qr - qg);
   dm_integrator_free(R);
   dm_integrator_free(G2);
 

@@ -1,5 +1,5 @@
-/* test_reduce_chart.c -- where the chart of a reduction is singular (spec
- * routh.md §6, §9; thesis §2.10.4).  The double spherical pendulum in
+/* test_reduce_chart.c -- where the chart of a reduction is singular
+ * (doc/reduce.md §15; thesis §2.10.4).  The double spherical pendulum in
  * V = R^3 x R^3 reduced by the simultaneous rotation in two charts besides the
  * cylindrical one (both bobs polar, singular at r1 = 0 and at r2 = 0):
  *   "bob 1 polar": (r1, theta1, z1) for bob 1, (xi2, eta2, z2) for bob 2

@@ -1,5 +1,5 @@
 /* test_reduce_constr.c -- reduction with forcing and with holonomic
- * constraints (thesis §2.8, Theorems 2.14, 2.16, 2.17; spec routh.md §6):
+ * constraints (thesis §2.8, Theorems 2.14, 2.16, 2.17; doc/reduce.md §11):
  *  - reduced forced = projected forced: RSPRK on the reduced force equals the
  *    unreduced forced Gauss 2 projected, mu conserved, energy decays;
  *  - the double spherical pendulum in R^3 x R^3 (cylindrical coordinates of

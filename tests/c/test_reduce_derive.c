@@ -1,6 +1,6 @@
 /* test_reduce_derive.c -- symbolic Routh reduction: the double spherical
- * pendulum's I, A, beta, V_mu against the closed forms of spec routh.md §9,
- * the J2 Routhian's centrifugal term (§8, symbolically and numerically),
+ * pendulum's I, A, beta, V_mu against the closed forms of doc/reduce.md §14,
+ * the J2 Routhian's centrifugal term (§13, symbolically and numerically),
  * set_mu without re-deriving, and the error paths (a cyclic coordinate L
  * depends on, a force with a cyclic component, a non-invariant constraint,
  * non-mechanical L, terms linear in v, r > 3). */

@@ -1,5 +1,5 @@
 /* test_reduce_dr.c -- discrete Routh reduction on the double spherical
- * pendulum (spec routh.md §4):
+ * pendulum (doc/reduce.md §6-7):
  *  - psi_mu: the midpoint closed form equals the Galerkin-Gauss-1 Newton
  *    solution, J_d((0, x0), (psi, x1)) = mu holds, Dpsi matches differences;
  *  - the general DR form (with Ahat_1, Ahat_2) equals the shape components

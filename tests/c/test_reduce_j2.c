@@ -1,4 +1,4 @@
-/* test_reduce_j2.c -- the J2 satellite (spec routh.md §8) reduced by the
+/* test_reduce_j2.c -- the J2 satellite (doc/reduce.md §13) reduced by the
  * azimuth theta: precession rates of the argument of periapsis and of the
  * node, measured on the reconstructed orbit (RSPRK Gauss 2 on (r, z), theta
  * by the Hamiltonian-side reconstruction) over 200 orbits with a fitted

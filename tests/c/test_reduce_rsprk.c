@@ -1,5 +1,5 @@
 /* test_reduce_rsprk.c -- RSPRK on the double spherical pendulum (a
- * non-trivial connection and magnetic term; spec routh.md §5):
+ * non-trivial connection and magnetic term; doc/reduce.md §9):
  *  1. momentum shift: sigma(RSPRK) = SPRK of the classical Routhian, both
  *     as the core engine on Rc directly and through the wrapped method;
  *  2. commutative cube: the unreduced SPRK started on J = mu, projected,

@@ -1,4 +1,5 @@
-/* test_tableau.c -- PRK coefficient generator against spec table T2.1,
+/* test_tableau.c -- PRK coefficient generator against the exact tables of
+ * doc/integrators.md §5,
  * symplecticity and row sums for s up to 8, user tableaus, error paths. */
 #include <config.h>
 #include <math.h>

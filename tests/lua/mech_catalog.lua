@@ -1,8 +1,8 @@
 -- mech_catalog.lua -- every system of dm.systems: documented, stepped
 -- briefly with its energy bounded, and checked against independent values:
--- the corrected J2 potential (spec routh.md 8), the same motion in two
+-- the corrected J2 potential (doc/reduce.md §13), the same motion in two
 -- coordinate systems, the locked inertia and mechanical connection of the
--- double spherical pendulum (spec routh.md 9), the built-in C versions.
+-- double spherical pendulum (doc/reduce.md §14), the built-in C versions.
 local T = require "dmech.test"
 local dm = require "dmech"
 
@@ -32,7 +32,7 @@ T.ok(d < 1e-14, ("harmonic, Gauss 2: energy conserved to round-off (%.2g)"):form
 
 -- pendulum (g = l = m = 1) = the built-in pendulum
 local pt = dm.integrator(dm.systems.pendulum{g = 1}, {method = "gauss", stages = 3, h = 0.1}):step{q = {1}, p = {0.5}}
-T.ok(math.abs(pt.q[1] - 1.0457503205397358305) < 1e-13, "pendulum{g=1}: spec T2.2 G3 value")
+T.ok(math.abs(pt.q[1] - 1.0457503205397358305) < 1e-13, "pendulum{g=1}: the one-step Gauss 3 reference value")
 d = drift(dm.systems.pendulum{l = 0.8}, {method = "trapezoid", h = 0.01}, {q = {2.385}, v = {0}}, 1000)
 T.ok(d < 1e-2 * 9.81 * 0.8, ("pendulum g=9.81 l=0.8, Stormer-Verlet: energy bounded (%.2g)"):format(d))
 
@@ -89,7 +89,7 @@ T.ok(d < 1e-5 * Esp, ("spherical pendulum, Gauss 2: energy bounded (%.2g)"):form
 d = drift(dm.systems.spherical_pendulum_r3{l = 1.3, m = 2, form = "norm"}, {method = "trapezoid", h = 0.01}, {q = qc, v = vc}, 500)
 T.ok(d < 2e-3 * Esp, ("spherical pendulum in R^3 (|q| - l form), RATTLE: energy bounded (%.2g)"):format(d))
 
--- double spherical pendulum: two forms, spec routh.md 9 reference values, R^3 x R^3
+-- double spherical pendulum: two forms, the closed forms of doc/reduce.md §14, R^3 x R^3
 local P = {g = 9.81, l1 = 1.1, l2 = 0.9, m1 = 1.3, m2 = 0.7}
 local cyl, shape, r33 = dm.systems.double_spherical_pendulum(P),
   dm.systems.double_spherical_pendulum{g = 9.81, l1 = 1.1, l2 = 0.9, m1 = 1.3, m2 = 0.7, form = "shape"},

@@ -1,7 +1,7 @@
 -- mech_integrators.lua -- the integrators through the Lua API on TRACED
--- systems: spec T2.2 one-step values (1e-13), T2.3 orders (within 0.1) for
--- Gauss s=1..4, Lobatto s=2..4 and every composition, T2.8 time reversal
--- (<= 1e-12), symplecticity defects (<= 1e-12 for symplectic methods,
+-- systems: the pendulum's one-step values (1e-13) and orders (within 0.1)
+-- for Gauss s=1..4, Lobatto s=2..4 and every composition, time reversal on
+-- Kepler (<= 1e-12; reference problems of doc/integrators.md §12), symplecticity defects (<= 1e-12 for symplectic methods,
 -- clearly non-zero for rk4), user PRK tableaus, the DEL view (discrete
 -- Legendre transforms, two-point steps) and the discrete momentum J_d.
 local T = require "dmech.test"
@@ -11,8 +11,8 @@ local pend = dm.system{name = "pendulum", coords = {"q"},
   L = function(q, v) return 0.5 * v.q^2 + dm.cos(q.q) end}
 local s0 = {q = {1}, p = {0.5}}
 
--- T2.2: one step, h = 0.1
-local t22 = {
+-- one step, h = 0.1 (doc/integrators.md §12.1)
+local one_step = {
   {{method = "midpoint"}, 1.0457319775935514958, 0.41463955187102991597},
   {{method = "gauss", stages = 1}, 1.0457319775935514958, 0.41463955187102991597},
   {{method = "gauss", stages = 2}, 1.045750310037518364, 0.41460947604204174098},
@@ -23,19 +23,19 @@ local t22 = {
   {{method = "lobatto", stages = 3}, 1.0457503318316956076, 0.41460947159014490595},
   {{method = "lobatto", stages = 4}, 1.0457503205353137737, 0.41460947550646890948},
 }
-for _, c in ipairs(t22) do
+for _, c in ipairs(one_step) do
   local o = c[1]
   o.h = 0.1
   local I = dm.integrator(pend, o)
   local s = I:step(s0)
   T.ok(math.abs(s.q[1] - c[2]) <= 1e-13 and math.abs(s.p[1] - c[3]) <= 1e-13 and s.t == 0.1,
-       ("T2.2 %s: q1 off by %.2g, p1 by %.2g"):format(tostring(I), s.q[1] - c[2], s.p[1] - c[3]))
+       ("pendulum one step %s: q1 off by %.2g, p1 by %.2g"):format(tostring(I), s.q[1] - c[2], s.p[1] - c[3]))
 end
 
--- T2.3: orders by step halving against the exact (q, p)(2)
+-- orders by step halving against the exact (q, p)(2) (doc/integrators.md §12.2)
 local exact = {q = {0.29104535735144390609}, p = {-1.0417697671437177188}}
 local std, long = {0.2, 0.1, 0.05, 0.025}, {0.5, 0.25, 0.125}
-local t23 = {
+local orders = {
   {{method = "gauss", stages = 1}, 2, std}, {{method = "gauss", stages = 2}, 4, std},
   {{method = "gauss", stages = 3}, 6, std}, {{method = "gauss", stages = 4}, 8, long},
   {{method = "lobatto", stages = 2}, 2, std}, {{method = "lobatto", stages = 3}, 4, std},
@@ -46,21 +46,21 @@ local t23 = {
   {{method = "composition", order = 8, scheme = "mclachlan8"}, 8, long},
   {{method = "composition", order = 8, scheme = "kahanli8"}, 8, long},
 }
-for _, c in ipairs(t23) do
+for _, c in ipairs(orders) do
   local o = {system = pend, state = s0, t = 2, h = c[3], reference = exact}
   for k, x in pairs(c[1]) do o[k] = x end
   local order, err = dm.order_estimate(o)
-  T.ok(math.abs(order - c[2]) <= 0.1, ("T2.3 %s %s: order %.3f (expected %d; errors %.3g .. %.3g)"):format(
+  T.ok(math.abs(order - c[2]) <= 0.1, ("pendulum order %s %s: order %.3f (expected %d; errors %.3g .. %.3g)"):format(
        c[1].method, c[1].stages or c[1].scheme, order, c[2], err[1], err[#err]))
 end
 local _, g2err = dm.order_estimate{system = pend, method = "gauss", stages = 2, state = s0, t = 2, h = std,
                                    reference = exact}
 T.ok(math.abs(g2err[1] / 1.587e-6 - 1) < 1e-3 and math.abs(g2err[4] / 3.883e-10 - 1) < 1e-3,
-     "T2.3 G2 errors are the spec's 1.587e-6 .. 3.883e-10")
+     "pendulum G2 errors are the reference 1.587e-6 .. 3.883e-10")
 local order_ref = dm.order_estimate{system = pend, method = "lobatto", stages = 3, state = s0, t = 2, h = std}
 T.ok(math.abs(order_ref - 4) <= 0.1, ("order against the default reference (Gauss 6): %.3f"):format(order_ref))
 
--- T2.8 time reversal and the symplecticity defect on Kepler e = 0.6
+-- time reversal (doc/integrators.md §12.6) and the symplecticity defect on Kepler e = 0.6
 local kep = dm.systems.kepler()
 local k0 = {q = {0.4, 0}, p = {0, 2}}
 local symplectic = {
@@ -78,7 +78,7 @@ for _, o in ipairs(symplectic) do
   local I = dm.integrator(kep, o)
   local rev, def = I:reversal(k0, 200), I:symplecticity_defect(k0)
   T.ok(I.symplectic and I.symmetric and rev <= 1e-12 and def <= 1e-12,
-       ("T2.8 %s: reversal after 2x200 steps %.2g, symplecticity defect %.2g"):format(tostring(I), rev, def))
+       ("Kepler %s: reversal after 2x200 steps %.2g, symplecticity defect %.2g"):format(tostring(I), rev, def))
 end
 local rk4 = dm.integrator(kep, {method = "rk4", h = 0.05})
 local drk = rk4:symplecticity_defect(k0)
@@ -90,7 +90,7 @@ T.ok(#jac == 4 and math.abs(jac:det() - 1) < 1e-13, "the step Jacobian is 4x4 wi
 -- user PRK tableaus
 local l3 = dm.tableau("lobatto", 3)
 T.ok(l3.s == 3 and l3.order == 4 and l3.symplectic and math.abs(l3.a[2][1] - 5 / 24) < 1e-16
-     and math.abs(l3.at[3][2] - 5 / 6) < 2.3e-16 and l3.defect < 1e-15, "dm.tableau('lobatto', 3): T2.1 coefficients")
+     and math.abs(l3.at[3][2] - 5 / 6) < 2.3e-16 and l3.defect < 1e-15, "dm.tableau('lobatto', 3): the exact coefficients")
 local g2 = dm.tableau("gauss", 2)
 T.near(g2.c[1], 0.21132486540518712, 1e-16, "dm.tableau('gauss', 2).c[1]")
 local prk = dm.integrator(pend, {method = "prk", tableau = {a = l3.a, b = l3.b, at = l3.at, c = l3.c}, h = 0.1})

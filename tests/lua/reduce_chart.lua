@@ -5,8 +5,8 @@
 -- I and A equal their closed forms, the chart is singular only at r1 = 0,
 -- positions (theta reconstructed) agree with the unreduced Cartesian
 -- constrained system to order 4, and at a close approach r2 -> 0 its energy
--- error stays at the h^4 level where the cylindrical chart spikes (spec
--- routh.md 6, 9; thesis 2.10.4).
+-- error stays at the h^4 level where the cylindrical chart spikes
+-- (doc/reduce.md §15; thesis §2.10.4).
 local T = require "dmech.test"
 local dm = require "dmech"
 

@@ -1,6 +1,6 @@
 -- reduce_routh.lua -- dm.routh from Lua: the derived formulas print, the double
--- spherical pendulum's I, A, beta, V_mu equal the closed forms of spec routh.md
--- 9, RSPRK / classical / discrete Routh agree through dm.integrator(red, ...),
+-- spherical pendulum's I, A, beta, V_mu equal the closed forms of doc/reduce.md
+-- §14, RSPRK / classical / discrete Routh agree through dm.integrator(red, ...),
 -- project -> run -> reconstruct equals the unreduced run, the non-canonical
 -- defect is at round-off, mu and parameters change without re-deriving, a
 -- singular locked inertia stops a run keeping the trajectory, and every error
@@ -31,7 +31,7 @@ do
   T.near(ev.routhian, 0.5 * (0.12^2 + 0.31^2) - V - mu^2 / (2 * r^2), 1e-14, "numeric Routhian with the centrifugal term")
 end
 
--- double spherical pendulum: closed forms (spec 9) -------------------------
+-- double spherical pendulum: closed forms (doc/reduce.md §14) -------------
 local P = {m1 = 1.3, m2 = 0.8, l1 = 1.1, l2 = 0.9, g = 9.81}
 local dsp = dm.systems.double_spherical_pendulum{m1 = P.m1, m2 = P.m2, l1 = P.l1, l2 = P.l2, g = P.g, form = "shape"}
 local mu = 0.537
