@@ -116,8 +116,9 @@ T.error_like(function() of:add{ obj, "u", "nosuch" } end, "column 'nosuch': .*no
 T.error_like(function() of:append(1, 1, 2) end, "series 1 is an object series", "append only on data series")
 of:close()
 
--- a trajectory is such an object
-if dm.trajectory then
+-- a trajectory is such an object (dm.trajectory is part of dmech: its absence is a failure)
+T.is(type(dm.trajectory), "function", "dm.trajectory exists")
+do
   local tt, r, th = {}, {}, {}
   for k = 1, 101 do
     tt[k] = (k - 1) * 0.05
@@ -130,9 +131,6 @@ if dm.trajectory then
   T.ok(c[1] == 101 + 2 and c[2] == 101, "a trajectory plots through :column (101 samples)")
   dm.plot{ {tr, "r", "theta", "t"}, output = dir .. "/traj3.png" }
   T.ok(H.png_size(dir .. "/traj3.png") == 640, "three trajectory columns: splot")
-else
-  T.skip("dm.trajectory not available")
-  T.skip("dm.trajectory not available")
 end
 
 -- DMECH_GNUPLOT_LOG records every command sent
