@@ -464,3 +464,76 @@ int dm_routh_dr_solve(dm_routh_dr *dr, double h, const double *xp, const double 
   }
   return st;
 }
+
+/* The step Jacobian by implicit differentiation of the reduced discrete
+ * Legendre transforms at the converged step.  In additive coordinates
+ * F-(x0, x1) = p0_x(q0, q1) - muA(x0) and F+(x0, x1) = p1_x(q0, q1) -
+ * muA(x1) with q0 = (0, x0), q1 = (psi_mu(x0, x1), x1) (the mu.Dpsi terms
+ * of D Lhat and Ahat cancel), so with the blocks dp/dq of the full
+ * discrete Lagrangian, Dpsi and K = d muA/dx:
+ *   P = dF-/dx0 = d00_xx + d01_xt D1psi - K(x0),  Q = dF-/dx1 = d01_xx + d01_xt D2psi,
+ *   R = dF+/dx0 = d10_xx + d11_xt D1psi,          S = dF+/dx1 = d11_xx + d11_xt D2psi - K(x1);
+ * s0 = F-(x0, x1) gives dx1 = Q^{-1} (ds0 - P dx0), and s1 = F+(x0, x1)
+ * ds1 = R dx0 + S dx1. */
+int dm_routh_dr_jacobian(dm_routh_dr *dr, double h, const double *x0, const double *s0,
+                         double *DPhi, dm_err *e)
+{
+  const dm_routh *red = dr->red;
+  size_t n = dr->n, r = dr->r, d = dr->d, N = 2 * d, i, k, a, j;
+  double *P, *Q, *R, *S, *K0, *K1, *Y, *x1, *s1, *mu_a;
+  int st;
+  if ((P = malloc((6 * d * d + N * d + 3 * d) * sizeof(double))) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  Q = P + d * d;
+  R = Q + d * d;
+  S = R + d * d;
+  K0 = S + d * d;
+  K1 = K0 + d * d;
+  Y = K1 + d * d;              /* d x 2d: Q^{-1} [-P | Id] */
+  x1 = Y + N * d;
+  s1 = x1 + d;
+  mu_a = s1 + d;
+  st = dm_routh_dr_step(dr, h, x0, s0, x1, s1, NULL, e);
+  if (st == DM_OK && (dm_routh_muA_K(red, x0, mu_a, K0, dr->tin, dr->twork)
+                      || dm_routh_muA_K(red, x1, mu_a, K1, dr->tin, dr->twork)))
+    st = dm_err_set(e, DM_EDOM, "mu^T A or its derivative is not finite at this point");
+  /* the step ended with lift(x0, x1) and derivatives: d.., Dpsi are current */
+  for (i = 0; st == DM_OK && i < d; i++)
+    for (k = 0; k < d; k++) {
+      size_t xi = red->shape[i], xk = red->shape[k];
+      double p = dr->d00[xi * n + xk], q = dr->d01[xi * n + xk];
+      double rr = dr->d10[xi * n + xk], ss = dr->d11[xi * n + xk];
+      for (a = 0; a < r; a++) {
+        double D1 = dr->Dpsi[a * 2 * d + k], D2 = dr->Dpsi[a * 2 * d + d + k];
+        size_t ta = red->cyc[a];
+        p += dr->d01[xi * n + ta] * D1;
+        q += dr->d01[xi * n + ta] * D2;
+        rr += dr->d11[xi * n + ta] * D1;
+        ss += dr->d11[xi * n + ta] * D2;
+      }
+      P[i * d + k] = p - K0[i * d + k];
+      Q[i * d + k] = q;
+      R[i * d + k] = rr;
+      S[i * d + k] = ss - K1[i * d + k];
+    }
+  if (st == DM_OK && dm_rlu_factor(&dr->lu_d, Q, d) != DM_OK)
+    st = dm_err_set(e, DM_ESINGULAR, "discrete Routh step Jacobian: dF-/dx1 is singular (h = %g)", h);
+  for (j = 0; st == DM_OK && j < N; j++) {
+    double *col = dr->sc;      /* 6 d scratch */
+    for (i = 0; i < d; i++)
+      col[i] = j < d ? -P[i * d + j] : (double)(i == j - d);
+    dm_rlu_solve(&dr->lu_d, Q, d, col);
+    for (i = 0; i < d; i++)
+      Y[i * N + j] = col[i];
+  }
+  for (i = 0; st == DM_OK && i < d; i++)
+    for (j = 0; j < N; j++) {
+      double acc = j < d ? R[i * d + j] : 0.0;
+      for (k = 0; k < d; k++)
+        acc += S[i * d + k] * Y[k * N + j];
+      DPhi[i * N + j] = Y[i * N + j];
+      DPhi[(d + i) * N + j] = acc;
+    }
+  free(P);
+  return st;
+}

@@ -217,8 +217,9 @@ const char *dm_routh_integrator_kind(const dm_integrator *I);
 
 /* Non-canonical symplecticity defect of one step at (x0, s0):
  * max |DPhi^T W(x1) DPhi - W(x0)| / max(1, max |W(x0)|) with
- * W(x) = [[-B(x), Id], [-Id, 0]] (doc/reduce.md §10).  DPhi exact for RSPRK and
- * classical, central differences for DR.  Not for constrained systems. */
+ * W(x) = [[-B(x), Id], [-Id, 0]] (doc/reduce.md §10).  DPhi exact (implicit
+ * differentiation of each method's step equations).  Not for constrained
+ * systems. */
 int dm_routh_symplecticity_defect(dm_integrator *I, double h, const double *x0,
                                   const double *s0, double *defect, dm_err *e);
 
@@ -257,6 +258,11 @@ int dm_routh_dr_solve(dm_routh_dr *dr, double h, const double *xp, const double 
  * *psi (may be NULL) receives psi_mu(x0, x1). */
 int dm_routh_dr_step(dm_routh_dr *dr, double h, const double *x0, const double *s0,
                      double *x1, double *s1, double *psi, dm_err *e);
+/* D(x1, s1)/D(x0, s0) (2s x 2s, row-major) of dm_routh_dr_step at
+ * (x0, s0), exact: implicit differentiation of the reduced discrete
+ * Legendre transforms with the second derivatives of L_d and D psi_mu. */
+int dm_routh_dr_jacobian(dm_routh_dr *dr, double h, const double *x0, const double *s0,
+                         double *DPhi, dm_err *e);
 /* Newton iterations of the last solve. */
 int dm_routh_dr_iters(const dm_routh_dr *dr);
 

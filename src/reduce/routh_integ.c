@@ -159,6 +159,7 @@ static int routh_alloc(dm_integrator *I, dm_err *e)
     I->order = t ? t->order : 2;
     dm_tableau_free(t);
     R->have_theta = 1;
+    I->flags |= DM_INTEG_EXACT_JAC;
     if (st == DM_OK && t == NULL)
       I->flags |= DM_INTEG_SYMMETRIC;
     return st;
@@ -328,7 +329,7 @@ static int routh_jacobian(dm_integrator *I, double h, const double *q0, const do
     return dm_rsprk_jacobian(R->P, h, q0, p0, DPhi, &I->stats, e);
   if (R->kind == K_CLASSICAL)
     return classical_jacobian(I, R, h, q0, p0, DPhi, e);
-  return dm_err_set(e, DM_EUNSUP, "no exact step Jacobian for the discrete Routh equations");
+  return dm_routh_dr_jacobian(R->dr, h, q0, p0, DPhi, e);
 }
 
 static void routh_reset(dm_integrator *I)

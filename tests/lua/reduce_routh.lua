@@ -114,6 +114,10 @@ end
 T.ok(rd:defect(st, {method = "gauss", stages = 3, h = 0.05}) <= 1e-10, "non-canonical symplecticity defect of RSPRK Gauss 3")
 T.ok(rd:defect(st, {method = "classical", stages = 2, h = 0.05}) <= 1e-10, "... and of the classical SPRK pulled back")
 do
+  local d = rd:defect(st, {method = "dr:gauss", stages = 2, h = 0.05})
+  T.ok(d <= 1e-13, ("... and of the discrete Routh step, with its exact Jacobian (%.2g)"):format(d))
+end
+do
   local psi_m = rd:psi({0.6, 0.5, 0.3}, {0.6031, 0.4962, 0.3118}, 0.05)
   local psi_g = rd:psi({0.6, 0.5, 0.3}, {0.6031, 0.4962, 0.3118}, 0.05, {method = "gauss", stages = 1})
   T.near(psi_m, psi_g, 1e-15, "psi_mu: midpoint closed form = Galerkin-Gauss 1")
