@@ -209,6 +209,12 @@ static int m_project(lua_State *L)
   lua_pop(L, 1);
   if ((st = dm_routh_project(u->red, q, p, xx, sx, mu, th, &e)) != DM_OK)
     return dm_lua_fail(L, "project", st, &e);
+  /* the reduced state only means something at the state's own mu: the
+   * reduction takes it (a run from the returned state at another mu would
+   * silently compute a different motion) */
+  if ((st = dm_routh_set_mu(u->red, mu, &e)) != DM_OK)
+    return dm_lua_fail(L, "project", st, &e);
+  sys_of(L, 1, 1)->gen++;
   if ((st = dm_routh_velocity(u->red, xx, sx, xd, &e)) != DM_OK)   /* Mtilde: mu-free */
     return dm_lua_fail(L, "project", st, &e);
   push_state(L, with_t, t, xx, sx, xd, s);
@@ -448,7 +454,8 @@ const dm_reg dm_lrouth_methods[] = {
    "Set the momentum value (a number, or one per cyclic coordinate) without re-deriving anything."},
   {"project", m_project, "red:project{q=, p= | v= [, t=]} -> reduced_state, mu, theta",
    "Project a full state: x = shape part, s = p_x - mu^T A(x), mu = p_theta (the state's own), theta; "
-   "the reduced state is {q = x, p = s, v = xdot}."},
+   "the reduced state is {q = x, p = s, v = xdot}.  The reduction takes the state's mu (red.mu "
+   "changes), so a reduced run from the returned state computes the motion of that state."},
   {"lift", m_lift, "red:lift(reduced_state[, theta]) -> {t=, q=, p=, v=}",
    "The full state over a reduced state (x, s) with the current mu: p_theta = mu, p_x = s + mu^T A, "
    "thetadot = I^-1 mu - A xdot."},
