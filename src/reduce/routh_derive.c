@@ -78,25 +78,87 @@ static int check_spec(dm_expr_ctx *c, const dm_routh_spec *sp, dm_err *e)
   return DM_OK;
 }
 
-/* dL/dtheta must vanish identically. */
-static int check_cyclic(dm_expr_ctx *c, const dm_routh_spec *sp, dm_err *e)
+/* Is expression x free of the cyclic coordinate a?  1: yes, *out is x with
+ * theta_a fixed at 0 (x itself when theta_a does not appear); 0: no, *d is
+ * dx/dtheta_a; -1: undecidable (dx/dtheta_a not finite at the sample
+ * points); DM_E* < -1 never (context errors are read by the caller).
+ * dx/dtheta_a that is not 0 as a formula is decided by evaluation
+ * (routh_cyclic.c): theta appears, through sin and cos, in Lagrangians
+ * written in Cartesian velocities of a rotating system. */
+static int free_of(dm_expr_ctx *c, const dm_routh_spec *sp, dm_expr x, size_t a, dm_expr *out,
+                   dm_expr *d)
 {
-  size_t a;
+  dm_expr th = sp->q[sp->cyclic[a]], zero = dm_expr_const(c, 0.0);
+  int z;
+  *out = x;
+  *d = zero;
+  if (!dm_expr_depends(c, x, 1, &th))
+    return 1;
+  *d = dm_expr_diff(c, x, th);
+  if (*d == DM_EXPR_NONE)
+    return -1;
+  z = is_zero(c, *d) ? 1 : dm_routh_zero_by_eval(c, *d, sp, sp->cyclic[a], NULL);
+  if (z == 1 && dm_expr_subs(c, 1, &x, out, 1, &th, &zero, NULL) != DM_OK)
+    return -1;
+  return z;
+}
+
+/* dL/dtheta must vanish: identically as a formula, or at every sample point
+ * (then L is replaced by the equivalent L with theta = 0).  A force's
+ * cyclic components and the theta-dependence of its shape components and
+ * of the constraints are treated the same way (what does not vanish is
+ * refused later with its own message).  sp2 is sp with the replaced
+ * expressions in buf (n + m nodes). */
+static int hidden_symmetry(dm_expr_ctx *c, const dm_routh_spec *sp, dm_routh_spec *sp2,
+                           dm_expr *buf, dm_err *e)
+{
+  size_t a, i;
+  *sp2 = *sp;
   for (a = 0; a < sp->r; a++) {
-    dm_expr th = sp->q[sp->cyclic[a]], d;
+    dm_expr d, Lfix;
     char pre[300];
-    if (!dm_expr_depends(c, sp->L, 1, &th))
-      continue;
-    d = dm_expr_diff(c, sp->L, th);
-    if (d == DM_EXPR_NONE)
+    int z = free_of(c, sp, sp2->L, a, &Lfix, &d);
+    const char *nm = coord_name(c, sp, sp->cyclic[a]);
+    if (dm_expr_ctx_err(c)->status != DM_OK)
       return ctx_fail(c, e, "dL/dtheta");
-    if (is_zero(c, d))
+    if (z == 1) {
+      sp2->L = Lfix;
       continue;
-    snprintf(pre, sizeof pre, "'%s' is not a cyclic coordinate: L depends on it, dL/d%s = ",
-             coord_name(c, sp, sp->cyclic[a]), coord_name(c, sp, sp->cyclic[a]));
+    }
+    if (z == 0)
+      snprintf(pre, sizeof pre, "'%s' is not a cyclic coordinate: L depends on it, dL/d%s = ", nm, nm);
+    else
+      snprintf(pre, sizeof pre, "cannot decide whether L depends on '%s': dL/d%s is not finite at "
+               "the sample points; dL/d%s = ", nm, nm, nm);
     return fail_expr(c, e, DM_EINVAL, pre, d,
                      " (write L with the symmetry explicit, e.g. in terms of differences of angles)");
   }
+  if (sp->force) {
+    memcpy(buf, sp->force, sp->n * sizeof *buf);
+    for (i = 0; i < sp->n; i++)
+      for (a = 0; a < sp->r; a++) {
+        dm_expr fix, d;
+        int cyclic_comp = i == sp->cyclic[a];
+        if (cyclic_comp && !is_zero(c, buf[i])
+            && dm_routh_zero_by_eval(c, buf[i], sp, sp->cyclic[a], NULL) == 1)
+          buf[i] = dm_expr_const(c, 0.0);
+        else if (free_of(c, sp, buf[i], a, &fix, &d) == 1)
+          buf[i] = fix;
+      }
+    sp2->force = buf;
+  }
+  if (sp->m) {
+    memcpy(buf + sp->n, sp->constraints, sp->m * sizeof *buf);
+    for (i = 0; i < sp->m; i++)
+      for (a = 0; a < sp->r; a++) {
+        dm_expr fix, d;
+        if (free_of(c, sp, buf[sp->n + i], a, &fix, &d) == 1)
+          buf[sp->n + i] = fix;
+      }
+    sp2->constraints = buf + sp->n;
+  }
+  if (dm_expr_ctx_err(c)->status != DM_OK)
+    return ctx_fail(c, e, "the theta-dependence of the force or constraints");
   return DM_OK;
 }
 
@@ -382,18 +444,13 @@ static void publish(dm_routh *red, const nodes *N)
   x->constraints = red->m ? N->g : NULL;
 }
 
-int dm_routh_derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_err *e)
+static int derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_err *e)
 {
   dm_routh *red;
   nodes N;
   dm_expr *tmp = NULL;
   size_t i, a, k;
   int st;
-  *out = NULL;
-  if (ctx == NULL || sp == NULL)
-    return dm_err_set(e, DM_EINVAL, "Routh reduction: no context or specification");
-  if ((st = check_spec(ctx, sp, e)) != DM_OK || (st = check_cyclic(ctx, sp, e)) != DM_OK)
-    return st;
   if ((red = calloc(1, sizeof *red)) == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
   red->n = sp->n;
@@ -470,5 +527,25 @@ int dm_routh_derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, d
 fail:
   free(tmp);
   dm_routh_free(red);
+  return st;
+}
+
+int dm_routh_derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_err *e)
+{
+  dm_routh_spec sp2;
+  dm_expr *buf;
+  int st;
+  *out = NULL;
+  if (ctx == NULL || sp == NULL)
+    return dm_err_set(e, DM_EINVAL, "Routh reduction: no context or specification");
+  if ((st = check_spec(ctx, sp, e)) != DM_OK)
+    return st;
+  if ((buf = malloc((sp->n + sp->m + 1) * sizeof *buf)) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  dm_expr_ctx_clear_err(ctx);
+  st = hidden_symmetry(ctx, sp, &sp2, buf, e);
+  if (st == DM_OK)
+    st = derive(ctx, &sp2, out, e);
+  free(buf);
   return st;
 }

@@ -105,6 +105,17 @@ int dm_routh_muA_K(const dm_routh *red, const double *x, double *muA, double *K,
 int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
                          unsigned what, dm_lag_out *out, void *work);
 
+/* Does d (an expression of the spec's q, v and parameters) vanish
+ * identically?  Evaluated with its magnitude at pseudo-random points
+ * (coordinate `angle` of q over [-pi, pi], the other positions in
+ * [0.15, 0.55], velocities in [-1, 1], parameters near their values):
+ * 1 when |d| <= 1e-10 times its magnitude at every finite point (at least
+ * 8), 0 when not at some point, -1 when too few points are finite or out
+ * of memory.  *worst (may be NULL): the largest |d| / magnitude seen
+ * (routh_cyclic.c). */
+int dm_routh_zero_by_eval(dm_expr_ctx *ctx, dm_expr d, const dm_routh_spec *sp, size_t angle,
+                          double *worst);
+
 /* Smallest and largest eigenvalue of the symmetric r x r matrix I (r <= 3;
  * closed form / Jacobi sweeps, no allocation). */
 void dm_routh_sym_eig(const double *I, size_t r, double *lmin, double *lmax);
