@@ -375,6 +375,18 @@ static const char *const fields =
   "A, beta, amended, potential, routhian, classical, I, Iinv, Mtilde, M, Iinv_mu, muA, thetadot, "
   "force, constraints, mu, cyclic, shape, system, full, name, r, s, n";
 
+/* fields that exist only for a mechanical L (derived formulas) */
+static int mechanical_only(const char *k)
+{
+  static const char *const names[] = {"A", "beta", "amended", "potential", "routhian", "classical",
+                                      "I", "Iinv", "Mtilde", "Iinv_mu", "muA", "thetadot", NULL};
+  const char *const *p;
+  for (p = names; *p; p++)
+    if (strcmp(*p, k) == 0)
+      return 1;
+  return 0;
+}
+
 static int r_index(lua_State *L)
 {
   dm_lrouth *u = dm_lrouth_check(L, 1);
@@ -385,6 +397,12 @@ static int r_index(lua_State *L)
   if (lua_getfield(L, lua_upvalueindex(1), k) != LUA_TNIL)     /* methods */
     return 1;
   lua_pop(L, 1);
+  if (!dm_routh_is_mechanical(red) && mechanical_only(k))
+    return luaL_error(L, "red.%s: '%s' is not mechanical (L is not quadratic in the velocities), "
+                      "so it has no locked inertia, connection or amended potential; its "
+                      "reduction is the classical Routhian Rc = L - mu.thetadot on J = mu, "
+                      "evaluated numerically (red:eval(x, xdot) gives Rc and thetadot)", k,
+                      dm_routh_full(red)->name);
   if (strcmp(k, "A") == 0)
     push_connection(L, red);
   else if (strcmp(k, "beta") == 0)
@@ -482,7 +500,9 @@ static int r_tostring(lua_State *L)
     dm_fmtnum(num, sizeof num, dm_routh_mu(u->red)[i]);
     luaL_addstring(&b, num);
   }
-  {
+  if (!dm_routh_is_mechanical(u->red)) {
+    luaL_addstring(&b, "; numerical (L is not quadratic in the velocities)");
+  } else {
     int zero = 1;
     dm_expr_ctx *c = dm_lua_exprctx(L);
     for (i = 0; i < x->s * x->s; i++)
@@ -540,7 +560,9 @@ static const dm_reg routh_funcs[] = {
    "connection A, amended potential, Routhian, classical Routhian, magnetic 2-form beta; "
    "dm.integrator(red, {method = ...}) runs RSPRK (gauss, midpoint, lobatto, trapezoid, prk), "
    "the discrete Routh equations (dr, dr:gauss, dr:lobatto) or classical-Routhian SPRK "
-   "(classical[:method]) on the reduced state (x, s = dR/dxdot)."},
+   "(classical[:method]) on the reduced state (x, s = dR/dxdot).  A Lagrangian that is not "
+   "quadratic in the velocities is reduced numerically: J = mu is solved for thetadot and the "
+   "reduced system is the classical Routhian L - mu.thetadot, state (x, p_x)."},
   {NULL, NULL, NULL, NULL}
 };
 

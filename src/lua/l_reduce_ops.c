@@ -325,6 +325,16 @@ static int m_eval(lua_State *L)
   dm_lua_system_readvec(L, rs, 2, "x", xx);
   if (!lua_isnoneornil(L, 3))
     dm_lua_system_readvec(L, rs, 3, "xdot", xd);
+  if (!dm_routh_is_mechanical(u->red)) {
+    memset(&v, 0, sizeof v);
+    v.thetadot = thd;
+    if ((st = dm_routh_eval(u->red, xx, xd, &v, &e)) != DM_OK)
+      return dm_lua_fail(L, "eval", st, &e);
+    lua_createtable(L, 0, 2);
+    dm_lrouth_push_numbers(L, thd, r); lua_setfield(L, -2, "thetadot");
+    lua_pushnumber(L, v.Rc); lua_setfield(L, -2, "classical");
+    return 1;
+  }
   v.I = I; v.Iinv = Ii; v.A = A; v.Iinv_mu = w; v.muA = muA; v.Mtilde = Mt; v.B = B;
   v.thetadot = thd;
   if ((st = dm_routh_eval(u->red, xx, xd, &v, &e)) != DM_OK)

@@ -104,6 +104,16 @@ int dm_routh_dr_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxite
   TAKE(J, d * d); TAKE(res, d); TAKE(x1, d); TAKE(dx, d); TAKE(tin, 2 * d); TAKE(tout, nout);
   TAKE(twork, red->nwork + r * r + 8); TAKE(Ld, 1); TAKE(dxprev, d); TAKE(sc, 6 * d);
 #undef TAKE
+  if (t == NULL && red->general) {   /* no closed-form psi: midpoint = Galerkin-Gauss 1 */
+    dm_tableau *g1 = NULL;
+    if ((st = dm_tableau_gauss(1, &g1, e)) == DM_OK)
+      st = dm_gld_alloc(&red->fsys, g1, dr->tol, dr->maxiter, &dr->g, e);
+    dm_tableau_free(g1);
+    if (st != DM_OK) {
+      dm_routh_dr_free(dr);
+      return st;
+    }
+  }
   if (t != NULL && (st = dm_gld_alloc(&red->fsys, t, dr->tol, dr->maxiter, &dr->g, e)) != DM_OK) {
     dm_routh_dr_free(dr);
     return st;
@@ -219,7 +229,16 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
   double Jr[DM_ROUTH_RMAX * DM_ROUTH_RMAX], f[DM_ROUTH_RMAX], dn = HUGE_VAL;
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
   int st, ok = 0;
-  if ((st = psi_midpoint(dr, h, x0, x1, 0, e)) != DM_OK)
+  if (red->general) {         /* start: h thetadot at the midpoint with the secant velocity */
+    for (i = 0; i < d; i++) {             /* Lq, Lv: free in the Galerkin path */
+      dr->Lq[i] = 0.5 * (x0[i] + x1[i]);
+      dr->Lv[i] = (x1[i] - x0[i]) / h;
+    }
+    if (dm_routh_general_thetadot(red, dr->Lq, dr->Lv, red->par, dr->psi, dr->rwork))
+      return dm_err_set(e, DM_EDOM, "psi_mu: J = mu has no solution thetadot between x0 and x1");
+    for (a = 0; a < r; a++)
+      dr->psi[a] *= h;
+  } else if ((st = psi_midpoint(dr, h, x0, x1, 0, e)) != DM_OK)
     return st;
   dm_routh_join(red, NULL, x0, dr->q0);
   for (it = 0; it < (size_t)dr->maxiter; it++) {

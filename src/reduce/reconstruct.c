@@ -36,6 +36,10 @@ static int shift_at(dm_routh *red, scr *S, const double *x, const double *mu, do
   size_t s = red->s, r = red->r, i;
   double lmin, lmax;
   char bx[200];
+  if (red->general) {          /* no connection: no momentum shift */
+    memset(a, 0, s * sizeof(double));
+    return DM_OK;
+  }
   memcpy(S->par2, red->par, red->np * sizeof(double));
   if (mu)
     memcpy(S->par2 + red->npar, mu, r * sizeof(double));
@@ -147,6 +151,8 @@ int dm_routh_velocity(dm_routh *red, const double *x, const double *s_, double *
   size_t d = red->s, i;
   double *z = red->lscratch, *Lv = z + d, *M = z + 3 * d, *w = M + d * d;
   dm_lag_out o;
+  if (red->general)
+    return dm_routh_general_velocity(red, x, s_, xdot, e);
   memset(&o, 0, sizeof o);
   memset(z, 0, d * sizeof(double));
   o.Lv = Lv;
@@ -174,6 +180,12 @@ static int full_velocity(dm_routh *red, const double *x, const double *s_, doubl
   int st = dm_routh_velocity(red, x, s_, xd, e);
   if (st != DM_OK)
     return st;
+  if (red->general) {
+    if (dm_routh_general_thetadot(red, x, xd, red->par, thd, S.twork))
+      return dm_err_set(e, DM_EDOM, "J = mu has no solution thetadot at this state");
+    dm_routh_join(red, thd, xd, v);
+    return DM_OK;
+  }
   memcpy(S.tin, x, d * sizeof(double));
   memcpy(S.tin + d, xd, d * sizeof(double));
   dm_rprog_run(&red->thd, S.tin, red->par, S.tout, S.twork);
@@ -308,6 +320,9 @@ int dm_routh_phase(dm_routh *red, const dm_traj *loop, double *dyn, double *geo,
   size_t d = red->s, r = red->r, len, k, i, a, jq[64];
   const double *t;
   double xb[64], dx[64], g = 0.0;
+  if (red->general)
+    return dm_err_set(e, DM_EUNSUP, "phase: L is not mechanical, there is no mechanical "
+                      "connection to split the phase with");
   if (loop == NULL || dm_traj_ncoords(loop) != d || d > 64)
     return dm_err_set(e, DM_EINVAL, "phase: the loop must be a trajectory of the %zu shape "
                       "coordinates", d);

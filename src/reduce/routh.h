@@ -52,6 +52,18 @@
  * (reconstruction): RSPRK h sum b_j Thetadot_j (Hamiltonian side), DR and
  * classical psi_mu(x0, x1) (Lagrangian side); see dm_routh_integrator_theta.
  *
+ * Non-mechanical Lagrangians.  When d2L/dv2 depends on v or L has terms
+ * linear in v, there is no locked inertia or mechanical connection; the
+ * derivation publishes only the symbols and M = d2L/dv2 (the other nodes
+ * of dm_routh_exprs are DM_EXPR_NONE / NULL) and the reduced system is
+ * the classical Routhian Rc = L - mu . thetadot on J = mu, evaluated
+ * numerically (thetadot by Newton, exact derivatives by implicit
+ * differentiation; routh_general.c).  The reduced state is (x, p_x)
+ * (no momentum shift); every method is the classical-Routhian one
+ * ("gauss" etc. = "classical:gauss"), "dr" uses the Galerkin L_d (midpoint
+ * = Gauss 1); dm_routh_eval gives thetadot and R = Rc only; phase is
+ * DM_EUNSUP; forces and constraints are refused (DM_EUNSUP).
+ *
  * Singular locked inertia.  Integrators check I at every stage point and at
  * x1: when its smallest eigenvalue drops below sing_tol (default 1e-10)
  * times the largest eigenvalue of I at the first step after creation/reset,
@@ -149,6 +161,8 @@ const dm_routh_exprs *dm_routh_exprs_get(const dm_routh *red);
 const dm_system *dm_routh_system(const dm_routh *red);     /* reduced, R^mu */
 const dm_system *dm_routh_classical(const dm_routh *red);  /* Rc, state (x, y) */
 const dm_system *dm_routh_full(const dm_routh *red);       /* unreduced */
+/* 0 when L is not mechanical (see "Non-mechanical Lagrangians" above). */
+int dm_routh_is_mechanical(const dm_routh *red);
 /* 1 if the system is the reduced system of a dm_routh (then *red is set). */
 int dm_routh_of_system(const dm_system *sys, dm_routh **red);
 

@@ -221,7 +221,7 @@ static int compile_system(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *
   return dm_lagrangian_compile(ctx, &ls, sys, e);
 }
 
-static int compile_full(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_system *sys, dm_err *e)
+int dm_routh_compile_full(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_system *sys, dm_err *e)
 {
   dm_lagrangian_spec ls;
   memset(&ls, 0, sizeof ls);
@@ -270,7 +270,7 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
     par[i] = sp->par[i];
   for (i = 0; i < red->r; i++)
     par[red->npar + i] = red->ex.mu[i];
-  if ((st = compile_full(ctx, sp, &red->fsys, e)) != DM_OK ||
+  if ((st = dm_routh_compile_full(ctx, sp, &red->fsys, e)) != DM_OK ||
       (st = compile_system(ctx, red, sp, x->R, par, "", &red->rsys, e)) != DM_OK ||
       (st = compile_system(ctx, red, sp, x->Rc, par, " (classical Routhian)", &red->csys, e)) != DM_OK)
     goto done;
@@ -357,6 +357,7 @@ void dm_routh_free(dm_routh *red)
     free(red->names[i]);
   free(red->names);
   free(red->name);
+  free(red->cname);
   free(red->shape);
   free(red->par);
   free(red->exbuf);
@@ -373,6 +374,7 @@ const dm_system *dm_routh_system(const dm_routh *red) { return &red->sys; }
 const dm_system *dm_routh_classical(const dm_routh *red) { return &red->csys; }
 const dm_system *dm_routh_full(const dm_routh *red) { return &red->fsys; }
 const double *dm_routh_mu(const dm_routh *red) { return red->par + red->npar; }
+int dm_routh_is_mechanical(const dm_routh *red) { return !red->general; }
 
 int dm_routh_of_system(const dm_system *sys, dm_routh **red)
 {
@@ -390,6 +392,13 @@ static void refresh(dm_routh *red)
   dm_system *ss[3] = {&red->fsys, &red->rsys, &red->csys};
   double *own[3] = {red->fpar_own, red->rpar_own, red->cpar_own};
   size_t k;
+  if (red->general) {            /* csys = rsys read red->par directly */
+    memcpy(own[0], red->par, red->npar * sizeof(double));
+    red->fsys.par = own[0];
+    dm_lagrangian_refresh(&red->fsys, NULL);
+    red->fsys.par = red->par;
+    return;
+  }
   memcpy(own[0], red->par, red->npar * sizeof(double));
   memcpy(own[1], red->par, red->np * sizeof(double));
   memcpy(own[2], red->par, red->np * sizeof(double));
@@ -438,11 +447,37 @@ static int finite_all(const double *x, size_t n)
   return 1;
 }
 
+/* A non-mechanical L has only the classical Routhian and thetadot. */
+static int general_eval(dm_routh *red, const double *x, const double *xdot, dm_routh_vals *v,
+                        dm_err *e)
+{
+  size_t s = red->s;
+  double *xd = red->scratch, *w = xd + s;
+  dm_lag_out o;
+  if (v->I || v->Iinv || v->A || v->Iinv_mu || v->muA || v->Mtilde || v->B)
+    return dm_err_set(e, DM_EUNSUP, "L is not mechanical: there is no locked inertia, connection "
+                      "or magnetic term, only the classical Routhian and thetadot");
+  if (xdot)
+    memcpy(xd, xdot, s * sizeof *xd);
+  else
+    memset(xd, 0, s * sizeof *xd);
+  memset(&o, 0, sizeof o);
+  if (dm_routh_general_thetadot(red, x, xd, red->par, v->thetadot ? v->thetadot : w, w + red->r)
+      || red->csys.lagrangian(red, x, xd, red->par, DM_LAG_L, &o, w + red->r) != 0)
+    return dm_err_set(e, DM_EDOM, "J(x, thetadot, xdot) = mu has no solution thetadot here (or L "
+                      "is outside its domain)");
+  v->detI = v->V = v->Vmu = NAN;
+  v->R = v->Rc = o.L;
+  return DM_OK;
+}
+
 int dm_routh_eval(dm_routh *red, const double *x, const double *xdot, dm_routh_vals *v,
                   dm_err *e)
 {
   size_t r = red->r, s = red->s, ss = s * s;
   double *in = red->scratch, *o = in + 2 * s, *w = o + red->info.nout;
+  if (red->general)
+    return general_eval(red, x, xdot, v, e);
   memcpy(in, x, s * sizeof *in);
   if (xdot)
     memcpy(in + s, xdot, s * sizeof *in);
@@ -520,6 +555,10 @@ int dm_routh_muA(const dm_routh *red, const double *x, double *muA, double *tin,
 {
   size_t s = red->s, i;
   int bad = 0;
+  if (!red->has_gyro) {
+    memset(muA, 0, s * sizeof *muA);
+    return 0;
+  }
   for (i = 0; i < s; i++) {
     tin[i] = x[i];
     tin[s + i] = 0.0;

@@ -162,7 +162,8 @@ static int hidden_symmetry(dm_expr_ctx *c, const dm_routh_spec *sp, dm_routh_spe
   return DM_OK;
 }
 
-/* M = d2L/dv2 independent of v; no terms linear in v; V = -L(q, 0). */
+/* M = d2L/dv2 independent of v; no terms linear in v; V = -L(q, 0).
+ * DM_EUNSUP otherwise: the caller then reduces numerically. */
 static int mechanical(dm_expr_ctx *c, const dm_routh_spec *sp, nodes *N, dm_expr *tmp, dm_err *e)
 {
   size_t n = sp->n, i;
@@ -172,9 +173,7 @@ static int mechanical(dm_expr_ctx *c, const dm_routh_spec *sp, nodes *N, dm_expr
   for (i = 0; i < n * n; i++)
     if (dm_expr_depends(c, N->M[i], n, sp->v))
       return fail_expr(c, e, DM_EUNSUP, "L is not mechanical (quadratic in the velocities): "
-                       "d2L/dv2 depends on v, e.g. ", N->M[i],
-                       "; Routh reduction of a non-mechanical L needs a numerical solve of J = mu, "
-                       "which is not supported");
+                       "d2L/dv2 depends on v, e.g. ", N->M[i], "");
   if (dm_expr_grad(c, sp->L, n, sp->v, Lv, NULL) != DM_OK)
     return ctx_fail(c, e, "dL/dv");
   for (i = 0; i < n; i++)
@@ -444,6 +443,47 @@ static void publish(dm_routh *red, const nodes *N)
   x->constraints = red->m ? N->g : NULL;
 }
 
+static int set_name(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh *red, dm_err *e)
+{
+  const char *nm = sp->name ? sp->name : "system";
+  char buf[400];
+  size_t a, len = (size_t)snprintf(buf, sizeof buf, "%s reduced by", nm);
+  for (a = 0; a < red->r && len < sizeof buf; a++)
+    len += (size_t)snprintf(buf + len, sizeof buf - len, "%s %s", a ? "," : "",
+                            coord_name(ctx, sp, red->cyc[a]));
+  if ((red->name = strdup(buf)) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  return DM_OK;
+}
+
+/* A Lagrangian that is not mechanical (mechanical() said why): only the
+ * symbols and the mass matrix d2L/dv2 (v-dependent) are published; the
+ * classical Routhian is evaluated numerically (routh_general.c).  Forces
+ * and constraints are reduced only for mechanical Lagrangians. */
+static int general(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh *red, nodes *N, dm_err *e)
+{
+  dm_routh_exprs *x = &red->ex;
+  int st;
+  if (sp->force || sp->m)
+    return dm_err_set(e, DM_EUNSUP, "L is not quadratic in the velocities: its Routh reduction is "
+                      "numerical and does not take %s (only mechanical Lagrangians L = 1/2 v^T "
+                      "M(x) v - V(x) are reduced with them)",
+                      sp->force ? "a force" : "constraints");
+  dm_expr_ctx_clear_err(ctx);
+  red->general = 1;
+  red->has_gyro = 0;
+  red->has_force = 0;
+  memset(x, 0, sizeof *x);
+  x->n = red->n; x->r = red->r; x->s = red->s; x->m = 0; x->npar = red->npar;
+  x->cyclic = red->cyc; x->shape = red->shape;
+  x->x = N->x; x->xdot = N->xd; x->theta = N->th; x->thetadot_sym = N->thd_sym;
+  x->mu = N->mu; x->M = N->M;
+  x->detI = x->V = x->Vmu = x->R = x->Rc = DM_EXPR_NONE;
+  if ((st = set_name(ctx, sp, red, e)) != DM_OK)
+    return st;
+  return dm_routh_general_setup(red, ctx, sp, e);
+}
+
 static int derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_err *e)
 {
   dm_routh *red;
@@ -493,7 +533,15 @@ static int derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_
     N.mu[a] = dm_expr_param(ctx, red->names[red->s + sp->npar + a]);
   }
   dm_expr_ctx_clear_err(ctx);
-  if ((st = mechanical(ctx, sp, &N, tmp, e)) != DM_OK || (st = connection(ctx, red, &N, e)) != DM_OK)
+  st = mechanical(ctx, sp, &N, tmp, e);
+  if (st == DM_EUNSUP) {         /* not quadratic in v: numerical classical Routhian */
+    if ((st = general(ctx, sp, red, &N, e)) != DM_OK)
+      goto fail;
+    free(tmp);
+    *out = red;
+    return DM_OK;
+  }
+  if (st != DM_OK || (st = connection(ctx, red, &N, e)) != DM_OK)
     goto fail;
   if (sp->force && (st = reduce_force(ctx, sp, red, &N, e)) != DM_OK)
     goto fail;
@@ -505,18 +553,8 @@ static int derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_
   }
   for (i = 0; i < red->s; i++)
     red->has_gyro |= !is_zero(ctx, N.muA[i]);
-  {
-    const char *nm = sp->name ? sp->name : "system";
-    char buf[400];
-    size_t len = (size_t)snprintf(buf, sizeof buf, "%s reduced by", nm);
-    for (a = 0; a < red->r && len < sizeof buf; a++)
-      len += (size_t)snprintf(buf + len, sizeof buf - len, "%s %s", a ? "," : "",
-                              coord_name(ctx, sp, red->cyc[a]));
-    if ((red->name = strdup(buf)) == NULL) {
-      st = dm_err_set(e, DM_ENOMEM, "out of memory");
-      goto fail;
-    }
-  }
+  if ((st = set_name(ctx, sp, red, e)) != DM_OK)
+    goto fail;
   publish(red, &N);
   st = dm_routh_compile_nodes(red, ctx, sp, N.K, N.kv, N.ib, N.dkv, N.dib, N.Dw, N.DA, e);
   if (st != DM_OK)

@@ -54,6 +54,10 @@ struct dm_routh {
   size_t cyc[DM_ROUTH_RMAX];
   size_t *shape;                   /* s */
   int has_gyro;                    /* mu^T A not identically zero */
+  int general;                     /* L not mechanical: no connection, the
+                                      classical Routhian is numerical
+                                      (routh_general.c); rsys = csys */
+  char *cname;                     /* general: name of csys */
   int has_force;
   double sing_tol;
   double *par;                     /* np: original params, then mu; shared by
@@ -102,6 +106,19 @@ int dm_routh_muA(const dm_routh *red, const double *x, double *muA, double *tin,
  * (muA, K then unspecified).  tin: 2 s, work: red->nwork doubles. */
 int dm_routh_muA_K(const dm_routh *red, const double *x, double *muA, double *K, double *tin,
                    double *work);
+/* The full system compiled from the spec (routh_compile.c). */
+int dm_routh_compile_full(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_system *sys, dm_err *e);
+/* routh_general.c: the reduction of a non-mechanical L.  setup compiles
+ * the full system and builds csys (= rsys) as the numerical classical
+ * Routhian; thetadot solves J(x, u, xdot) = mu (par: the np parameters,
+ * work: dm_routh_general_work bytes; 0, or 1 when there is no solution);
+ * velocity inverts p_x = dRc/dxdot by Newton (red's scratch). */
+int dm_routh_general_setup(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_err *e);
+size_t dm_routh_general_work(const dm_routh *red);
+int dm_routh_general_thetadot(const dm_routh *red, const double *x, const double *xd,
+                              const double *par, double *u, void *work);
+int dm_routh_general_velocity(dm_routh *red, const double *x, const double *px, double *xd,
+                              dm_err *e);
 int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
                          unsigned what, dm_lag_out *out, void *work);
 

@@ -168,6 +168,12 @@ static int routh_alloc(dm_integrator *I, dm_err *e)
     R->kind = K_CLASSICAL;
     return alloc_classical(I, R, sub ? sub : "gauss", e);
   }
+  if (red->general && sub == NULL) {
+    /* no connection, no RSPRK stage programs: with the momentum shift the
+     * identity, RSPRK is the same method on the classical Routhian */
+    R->kind = K_CLASSICAL;
+    return alloc_classical(I, R, fam, e);
+  }
   if (sub != NULL)
     return dm_err_set(e, DM_ENOTFOUND, "unknown reduced method '%s:%s'", fam, sub);
   R->kind = K_RSPRK;
@@ -441,7 +447,9 @@ int dm_routh_symplecticity_defect(dm_integrator *I, double h, const double *x0, 
   for (k = 0; st == DM_OK && k < 2; k++) {
     double *W = k ? W1 : W0;
     v.B = T;
-    if ((st = dm_routh_eval(red, k ? x1 : x0, NULL, &v, e)) != DM_OK)
+    if (red->general)            /* (x, p_x) canonical: no magnetic term */
+      memset(T, 0, d * d * sizeof(double));
+    else if ((st = dm_routh_eval(red, k ? x1 : x0, NULL, &v, e)) != DM_OK)
       break;
     for (i = 0; i < d; i++)
       for (j = 0; j < d; j++)

@@ -3,7 +3,8 @@
  * the J2 Routhian's centrifugal term (§13, symbolically and numerically),
  * set_mu without re-deriving, and the error paths (a cyclic coordinate L
  * depends on, a force with a cyclic component, a non-invariant constraint,
- * non-mechanical L, terms linear in v, r > 3). */
+ * r > 3) and the numerical reduction of L with terms linear in v or not
+ * quadratic in v. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>
@@ -193,14 +194,38 @@ static void errors(void)
            e.msg);
     sp.m = 0;
     sp.constraints = NULL;
-    /* terms linear in v */
-    sp.L = dm_expr_add(S.c, S.L, dm_expr_mul(S.c, S.q[0], S.v[1]));
-    st = dm_routh_derive(S.c, &sp, &red, &e);
-    tap_ok(st == DM_EUNSUP && strstr(e.msg, "linear"), "terms linear in v: %s", e.msg);
-    /* non-mechanical */
-    sp.L = dm_expr_add(S.c, S.L, dm_expr_powi(S.c, S.v[0], 4));
-    st = dm_routh_derive(S.c, &sp, &red, &e);
-    tap_ok(st == DM_EUNSUP && strstr(e.msg, "not mechanical"), "non-mechanical L: %s", e.msg);
+    /* terms linear in v, and a term rdot^4: no longer refused, reduced
+     * numerically (J = mu solved for thetadot); compare with the hand
+     * solutions thetadot = (mu - r)/r^2 and mu/r^2 */
+    {
+      const double x[2] = {1.7385, 0.4127}, xd[2] = {0.12, -0.31}, mu1 = 1.1;
+      double r = x[0], z = x[1], R = hypot(r, z), J2 = 0.05, thd, Rc_e, w[1];
+      double V = -1 / R + J2 / (R * R * R) * (1.5 * z * z / (R * R) - 0.5);
+      dm_routh_vals v;
+      int k;
+      sp.mu = &mu1;
+      for (k = 0; k < 2; k++) {
+        sp.L = k == 0 ? dm_expr_add(S.c, S.L, dm_expr_mul(S.c, S.q[0], S.v[1]))
+                      : dm_expr_add(S.c, S.L, dm_expr_powi(S.c, S.v[0], 4));
+        st = dm_routh_derive(S.c, &sp, &red, &e);
+        memset(&v, 0, sizeof v);
+        v.thetadot = w;
+        if (st == DM_OK)
+          st = dm_routh_eval(red, x, xd, &v, &e);
+        thd = k == 0 ? (mu1 - r) / (r * r) : mu1 / (r * r);
+        Rc_e = 0.5 * (xd[0] * xd[0] + r * r * thd * thd + xd[1] * xd[1]) - V - mu1 * thd
+               + (k == 0 ? r * thd : pow(xd[0], 4));
+        tap_ok(st == DM_OK && !dm_routh_is_mechanical(red) && relerr(w[0], thd) <= 1e-15
+               && relerr(v.Rc, Rc_e) <= 1e-14,
+               "%s: reduced numerically, thetadot %.17g (hand %.17g), Rc %.17g (hand %.17g)",
+               k == 0 ? "terms linear in v" : "rdot^4 (not quadratic)", w[0], thd, v.Rc, Rc_e);
+        if (st != DM_OK)
+          tap_diag("%s", e.msg);
+        dm_routh_free(red);
+        red = NULL;
+      }
+      sp.mu = NULL;
+    }
     /* r out of range */
     sp.L = S.L;
     sp.r = 3;
