@@ -1,0 +1,223 @@
+/* dec.h -- discrete exterior calculus on simplicial complexes (doc/dec.md).
+ *
+ * Three objects, each immutable once built:
+ *
+ *   dm_dec_complex  the topology: pure oriented simplicial complex of
+ *                   dimension n <= DM_DEC_MAXDIM, its simplices of every
+ *                   dimension, face tables and the exact integer exterior
+ *                   derivatives d_k = boundary_{k+1}^T.
+ *   dm_dec_geom     one metric on a complex: squared edge lengths (from
+ *                   vertex coordinates in R^N, or given: the intrinsic
+ *                   "local metric" mode), primal volumes, circumcentres,
+ *                   signed circumcentric dual volumes and their pieces in
+ *                   every top simplex.  Several geometries may share one
+ *                   complex (a discrete map is two of them).
+ *   dm_dec_meshdata a plain vertex/simplex table (generators, files).
+ *
+ * Conventions (doc/dec.md §1): k-simplices for k < n are stored with
+ * increasing vertex indices and numbered in lexicographic order; top
+ * simplices keep the caller's order and the caller's vertex order, which is
+ * their orientation (top_sign = parity relative to the sorted row).  Dual
+ * cells are oriented so that orientation(s) ^ orientation(*s) is the
+ * orientation of the top simplices; then the dual derivative on dual
+ * j-cochains is (-1)^(n-j) boundary_{n-j} (= (-1)^(n-j) d_{n-j-1}^T),
+ * *_k = diag(|*s|/|s|), ** = (-1)^(k(n-k)), delta_k = *_{k-1}^-1 d_{k-1}^T *_k
+ * and Delta_k = d delta + delta d is positive semidefinite.
+ *
+ * Ownership: _alloc / _free pairs; _free(NULL) is a no-op.  A geometry keeps a
+ * pointer to its complex, which must outlive it.  Matrices and vectors
+ * returned through pointer arguments are new and owned by the caller
+ * (dm_sparse_free / free).
+ *
+ * Errors: functions return DM_OK or a DM_E* status (or NULL) and fill the
+ * dm_err (may be NULL) with a message naming the simplex (1-based vertex
+ * lists) or the argument at fault.  Nothing prints; warnings are data
+ * (dm_dec_geom fields nonpos, not_well_centered) for the caller to report.
+ *
+ * Threads: complexes and geometries are read-only after _alloc and may be
+ * shared by any number of threads; every function here is reentrant.
+ */
+#ifndef DM_DEC_H
+#define DM_DEC_H
+
+#include "core/status.h"
+#include "dec/sparse.h"
+
+#define DM_DEC_MAXDIM 4
+
+/* {==== raw meshes ========================================================== */
+
+typedef struct dm_dec_meshdata {
+  int n;          /* dimension of the top simplices */
+  int N;          /* embedding dimension (coordinates per vertex) */
+  int nv, ntop;
+  double *X;      /* nv x N */
+  int *T;         /* ntop x (n + 1), 0-based, orientation = vertex order */
+} dm_dec_meshdata;
+
+/* Allocate arrays for nv vertices and ntop simplices (X, T uninitialised). */
+dm_dec_meshdata *dm_dec_meshdata_alloc(int n, int N, int nv, int ntop, dm_err *e);
+void dm_dec_meshdata_free(dm_dec_meshdata *m);
+
+/* Generators.  All produce consistently oriented meshes (counterclockwise in
+ * the plane, outward normals on closed surfaces, positive volume for tets).
+ *   grid:    [x0,x1] x [y0,y1], nx x ny squares, each square [a,b,d,c] split
+ *            along its diagonal a-d (right triangles).
+ *   disc:    radius r, nr rings of 6i vertices (1 + 3 nr (nr+1) vertices,
+ *            6 nr^2 nearly equilateral triangles).
+ *   annulus: radii r0 < r1, nr rings of m vertices, odd rings turned by half
+ *            a step (m >= 3, nr >= 1).
+ *   sphere:  radius r, icosahedron subdivided `level` times 1 -> 4 (10 4^L + 2
+ *            vertices).
+ *   torus:   radii R > r, m vertices around the big circle, n (even) around
+ *            the tube, odd rows staggered by half a step; vertex (i, j) at
+ *            u = 2 pi (i + (j mod 2)/2)/m, v = 2 pi j / n.
+ *   box:     [0,a] x [0,b] x [0,c], nx x ny x nz cubes of 6 tetrahedra each
+ *            (Kuhn split along the cube diagonal).
+ *   path:    vertices x_0..x_np on the real line (np segments; x given). */
+dm_dec_meshdata *dm_dec_gen_grid(int nx, int ny, double x0, double x1, double y0,
+                                 double y1, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_disc(double r, int nr, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_annulus(double r0, double r1, int nr, int m, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_sphere(double r, int level, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_torus(double R, double r, int m, int n, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_box(int nx, int ny, int nz, double a, double b,
+                                double c, dm_err *e);
+dm_dec_meshdata *dm_dec_gen_path(int np, const double *x, dm_err *e);
+
+/* One level of nested refinement: every triangle split 1 -> 4 at edge
+ * midpoints (n = 2), every segment 1 -> 2 (n = 1).  When parent is not NULL
+ * it receives, for every new vertex, the two vertices of its coarse edge
+ * (old vertices: both entries equal the vertex itself), 2 ints per vertex. */
+dm_dec_meshdata *dm_dec_refine(const dm_dec_meshdata *m, int **parent, dm_err *e);
+
+/* }==== */
+
+/* {==== the complex ========================================================== */
+
+typedef struct dm_dec_complex {
+  int n;                            /* dimension */
+  int nsimp[DM_DEC_MAXDIM + 1];     /* number of k-simplices */
+  int *simp[DM_DEC_MAXDIM + 1];     /* nsimp[k] x (k+1) vertex indices, rows
+                                       increasing; simp[n]: rows sorted, table
+                                       in input order */
+  int *top;                         /* nsimp[n] x (n+1) in input vertex order */
+  signed char *top_sign;            /* +1/-1: parity of top[] against simp[n] */
+  int nface[DM_DEC_MAXDIM + 1];     /* C(n+1, k+1): k-faces of a top simplex */
+  int *face[DM_DEC_MAXDIM + 1];     /* nsimp[n] x nface[k]: global index of the
+                                       k-face of top t with local mask
+                                       dm_dec_face_mask(n, k, j) (bits over the
+                                       sorted row simp[n][t]) */
+  dm_sparse *d[DM_DEC_MAXDIM];      /* d[k]: N_{k+1} x N_k, entries +-1 */
+  unsigned char *boundary[DM_DEC_MAXDIM + 1]; /* 1 when the k-simplex lies in
+                                       the boundary subcomplex */
+  int manifold;                     /* every (n-1)-face has 1 or 2 cofaces */
+  int oriented;                     /* the two cofaces of every interior
+                                       (n-1)-face induce opposite signs */
+} dm_dec_complex;
+
+/* The complex of ntop top simplices T (ntop x (n+1), 0-based, vertex order =
+ * orientation) on nv vertices.  Errors (DM_EINVAL, naming the simplex): an
+ * index outside 0..nv-1, a repeated vertex, two top simplices with the same
+ * vertex set, a vertex in no simplex (only pure complexes are supported),
+ * n outside 1..DM_DEC_MAXDIM. */
+dm_dec_complex *dm_dec_complex_alloc(int n, int nv, int ntop, const int *T,
+                                     dm_err *e);
+void dm_dec_complex_free(dm_dec_complex *K);
+
+/* Local k-faces of an n-simplex: bit masks over its n+1 sorted vertices, in
+ * lexicographic order of the faces; dm_dec_face_index inverts it. */
+unsigned dm_dec_face_mask(int n, int k, int j);
+int dm_dec_face_index(int n, unsigned mask);
+
+/* Index of the k-simplex with the given (k+1) vertices (any order), or -1. */
+int dm_dec_find(const dm_dec_complex *K, int k, const int *v);
+
+/* The first defect among: an (n-1)-face with more than two cofaces
+ * ("non-manifold"), two cofaces inducing the same orientation on a shared
+ * face ("inconsistent orientation").  DM_OK when neither. */
+int dm_dec_complex_check(const dm_dec_complex *K, dm_err *e);
+
+/* Betti numbers b_0..b_n, exactly: ranks of the boundary matrices by
+ * elimination modulo the prime 2^31 - 1 (equal to the rational ranks unless
+ * that prime divides a torsion coefficient of the integral homology). */
+int dm_dec_betti(const dm_dec_complex *K, int *betti, dm_err *e);
+
+/* }==== */
+
+/* {==== geometry ============================================================= */
+
+typedef struct dm_dec_geom {
+  const dm_dec_complex *K;          /* not owned */
+  int N;                            /* coordinates per vertex (0: intrinsic) */
+  double *X;                        /* nv x N copy, NULL when intrinsic */
+  double *len2;                     /* squared edge lengths, nsimp[1] */
+  double *vol[DM_DEC_MAXDIM + 1];   /* primal volumes, vol[0] = 1 */
+  double *dual[DM_DEC_MAXDIM + 1];  /* signed dual volumes |*s| (|*top| = 1) */
+  double *piece[DM_DEC_MAXDIM + 1]; /* nsimp[n] x nface[k]: signed |*s cap t| */
+  double *cc[DM_DEC_MAXDIM + 1];    /* circumcentres nsimp[k] x N (NULL when
+                                       intrinsic) */
+  int nonpos[DM_DEC_MAXDIM + 1];    /* simplices with dual volume <= 0 */
+  int not_well_centered;            /* simplices (k >= 1) whose circumcentre is
+                                       not strictly inside */
+} dm_dec_geom;
+
+/* Geometry from vertex coordinates X (nv x N, N >= n). */
+dm_dec_geom *dm_dec_geom_alloc(const dm_dec_complex *K, int N, const double *X,
+                               dm_err *e);
+/* Intrinsic geometry from squared edge lengths (indexed like simp[1]).
+ * Checked: lengths positive, and every simplex of dimension >= 2 has a
+ * positive squared volume (Cayley-Menger; triangle inequalities alone do
+ * not guarantee a tetrahedron): DM_EDOM naming the simplex otherwise. */
+dm_dec_geom *dm_dec_geom_alloc_intrinsic(const dm_dec_complex *K,
+                                         const double *len2, dm_err *e);
+void dm_dec_geom_free(dm_dec_geom *G);
+
+/* Barycentric coordinates of the circumcentre of the k-simplex s (k+1
+ * values, summing to 1). */
+int dm_dec_circumcenter_bary(const dm_dec_geom *G, int k, int s, double *b,
+                             dm_err *e);
+
+/* }==== */
+
+/* {==== operators ============================================================ */
+
+/* Hodge star *_k as a vector (primal k -> dual n-k): |*s|/|s|.  With
+ * inverse != 0: the star from dual (n-k) to primal k, (-1)^(k(n-k)) |s|/|*s|;
+ * DM_ESINGULAR naming the first simplex with |*s| = 0. */
+int dm_dec_star(const dm_dec_geom *G, int k, int inverse, double *out, dm_err *e);
+
+/* d_k (N_{k+1} x N_k) and the dual derivative on dual j-cochains,
+ * (-1)^(n-j) d_{n-j-1}^T (N_{n-j-1} x N_{n-j}). */
+dm_sparse *dm_dec_d(const dm_dec_complex *K, int k, dm_err *e);
+dm_sparse *dm_dec_dual_d(const dm_dec_complex *K, int j, dm_err *e);
+
+/* The codifferential delta_k = *_{k-1}^-1 d_{k-1}^T *_k (N_{k-1} x N_k),
+ * k >= 1. */
+dm_sparse *dm_dec_codiff(const dm_dec_geom *G, int k, dm_err *e);
+
+/* Laplace-de Rham Delta_k = d delta + delta d (N_k x N_k), and its symmetric
+ * form S = *_k Delta_k (either pointer may be NULL). */
+int dm_dec_laplacian(const dm_dec_geom *G, int k, dm_sparse **delta,
+                     dm_sparse **sym, dm_err *e);
+
+/* }==== */
+
+/* {==== solving operators of the form diag(w)^-1 S ============================ */
+
+/* A factored Dirichlet problem: S symmetric (n x n), `fixed` flags (may be
+ * NULL) the unknowns prescribed by boundary values.  CHOLMOD factors S on the
+ * free unknowns once; DM_ESINGULAR (naming the pivot) when that block is not
+ * positive definite. */
+typedef struct dm_dec_solver dm_dec_solver;
+dm_dec_solver *dm_dec_solver_alloc(const dm_sparse *S, const unsigned char *fixed,
+                                   dm_err *e);
+/* Find u with u = g on fixed unknowns and (diag(w)^-1 S u) = f on the free
+ * ones (w == NULL: w = 1; g == NULL: g = 0). */
+int dm_dec_solver_solve(dm_dec_solver *F, const double *w, const double *f,
+                        const double *g, double *u, dm_err *e);
+void dm_dec_solver_free(dm_dec_solver *F);
+
+/* }==== */
+
+#endif
