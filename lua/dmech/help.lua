@@ -55,7 +55,11 @@ function M.help(x)
   if x == nil then return overview(docs) end
   if type(x) ~= "string" then
     local rec = byval[x]
-    if rec then return show(rec) end
+    if rec then
+      show(rec)
+      if type(x) == "table" then show_group(docs, rec.name .. ".") end  -- a module: its members
+      return
+    end
     local cls = classname(x)
     if cls and show_group(docs, cls .. ":") > 0 then return end
     out("no help for this ", type(x), " value\n")
@@ -63,7 +67,10 @@ function M.help(x)
   end
   local name = x
   local rec = docs[name] or docs["dm." .. name]
-  if rec then show(rec) end
+  if rec then
+    show(rec)
+    show_group(docs, rec.name .. ".")      -- a module (dm.test): its members
+  end
   if show_group(docs, name .. ":") > 0 or rec then return end
   if show_group(docs, name .. ".") > 0 then return end
   -- a bare method or function name: every entry ending in it

@@ -23,4 +23,6 @@ dm.doc("dm.pretty", "dm.pretty(x[, depth]) -> string",
        "The REPL's rendering of a value: tables to depth 3 with truncation, objects by __tostring.",
        dm.pretty)
 
+dm.test = require "dmech.test"
+
 return dm
