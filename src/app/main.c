@@ -20,6 +20,7 @@
 #include "core/interrupt.h"
 #include "lua/dmlua.h"
 #include "app/repl.h"
+#include "app/testrun.h"
 
 static const char *progname = DM_PROGNAME;
 
@@ -120,6 +121,7 @@ static void print_usage(const char *badoption)
   }
   fprintf(f,
     "usage: %s [options] [script [args]]\n"
+    "       %s test [options] [files or directories]  (run *_test.lua files)\n"
     "Computational geometric mechanics at a Lua 5.4 prompt.\n"
     "Available options are:\n"
     "  -e stat   execute string 'stat'\n"
@@ -136,7 +138,7 @@ static void print_usage(const char *badoption)
     "DMECH_PATH adds directories searched for dmech's Lua library;\n"
     "DMECH_GNUPLOT names the gnuplot program.\n"
     "In the interactive prompt: help(x), help \"name\", apropos \"word\".\n",
-    progname);
+    progname, progname);
   fflush(f);
 }
 
@@ -412,6 +414,8 @@ int main(int argc, char **argv)
   int status, result;
   lua_State *L;
   setlocale(LC_CTYPE, "");        /* Readline and UTF-8; numbers stay "C" */
+  if (argc > 1 && strcmp(argv[1], "test") == 0)
+    return dm_testrun(argc, argv);  /* `dmech test`: the test runner */
   L = luaL_newstate();
   if (L == NULL) {
     l_message(argv[0], "cannot create state: not enough memory");
