@@ -1,6 +1,7 @@
 /* status.c -- status names, error records, GSL status mapping. */
 #include <config.h>
 #include "core/status.h"
+#include "core/numfmt.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -11,7 +12,8 @@ const char *dm_strstatus(int status)
   static const char *const names[] = {
     "success", "invalid argument", "out of memory", "no convergence",
     "singular matrix", "domain error", "interrupted", "input/output error",
-    "not found", "not supported", "callback failed", "timeout", "failed"
+    "not found", "not supported", "callback failed", "timeout", "failed",
+    "diverged"
   };
   if (status < 0 || status >= (int)(sizeof names / sizeof names[0]))
     return "unknown status";
@@ -24,7 +26,7 @@ int dm_err_set(dm_err *e, int status, const char *fmt, ...)
     va_list ap;
     e->status = status;
     va_start(ap, fmt);
-    vsnprintf(e->msg, sizeof e->msg, fmt, ap);
+    dm_num_vsnprintf(e->msg, sizeof e->msg, fmt, ap);
     va_end(ap);
   }
   return status;

@@ -26,7 +26,9 @@ enum dm_status {
   DM_EUNSUP,     /* combination not supported */
   DM_ECALLBACK,  /* a user callback reported failure */
   DM_ETIMEOUT,   /* an external process did not answer in time */
-  DM_EFAILED     /* generic failure; see message */
+  DM_EFAILED,    /* generic failure; see message */
+  DM_EDIVERGED,  /* a run left its bounds (non-finite energy, energy error) */
+  DM_NSTATUS     /* number of status codes (not a status) */
 };
 
 #define DM_ERRMSG_MAX 512

@@ -76,8 +76,13 @@ enum dm_system_flags {
   DM_SYS_MECHANICAL = 1u << 1
 };
 
+/* System kinds (dm_system.kind): which integrator families apply
+ * (integrator.h).  NULL means DM_SYSTEM_LAGRANGIAN. */
+#define DM_SYSTEM_LAGRANGIAN "lagrangian"   /* L(q, v) on R^n (coordinates) */
+
 typedef struct dm_system {
   const char *name;
+  const char *kind;             /* static string; NULL: DM_SYSTEM_LAGRANGIAN */
   size_t n;                     /* coordinates */
   size_t npar;                  /* parameters */
   size_t m;                     /* constraints (0: none) */

@@ -9,12 +9,20 @@
 #include <string.h>
 
 #include "core/interrupt.h"
+#include "core/numfmt.h"
 
 typedef struct column {
   char *name;
   int kind;
   double *x;          /* capacity >= tr->cap values (NULL while cap == 0) */
 } column;
+
+/* A metadata item: a string, or a number (with its text in val). */
+typedef struct meta {
+  char *key, *val;
+  int isnum;
+  double x;
+} meta;
 
 struct dm_traj {
   size_t n;           /* coordinates */
@@ -23,7 +31,7 @@ struct dm_traj {
   column *cols;
   size_t ncols, colcap;
   size_t len, cap;    /* samples stored, samples every column can hold */
-  char **mkey, **mval;
+  meta *m;            /* metadata in insertion order */
   size_t nmeta, metacap;
 };
 
@@ -211,11 +219,10 @@ void dm_traj_free(dm_traj *tr)
   }
   free(tr->cols);
   for (j = 0; j < tr->nmeta; j++) {
-    free(tr->mkey[j]);
-    free(tr->mval[j]);
+    free(tr->m[j].key);
+    free(tr->m[j].val);
   }
-  free(tr->mkey);
-  free(tr->mval);
+  free(tr->m);
   free(tr);
 }
 
@@ -595,9 +602,13 @@ static int copy_meta(dm_traj *dst, const dm_traj *src, dm_err *e)
 {
   size_t i;
   int st;
-  for (i = 0; i < src->nmeta; i++)
-    if ((st = dm_traj_meta_set(dst, src->mkey[i], src->mval[i], e)) != DM_OK)
+  for (i = 0; i < src->nmeta; i++) {
+    const meta *m = &src->m[i];
+    st = m->isnum ? dm_traj_meta_set_number(dst, m->key, m->x, e)
+                  : dm_traj_meta_set(dst, m->key, m->val, e);
+    if (st != DM_OK)
       return st;
+  }
   return DM_OK;
 }
 
@@ -654,7 +665,7 @@ static size_t meta_find(const dm_traj *tr, const char *key)
 {
   size_t i;
   for (i = 0; i < tr->nmeta; i++)
-    if (strcmp(tr->mkey[i], key) == 0)
+    if (strcmp(tr->m[i].key, key) == 0)
       return i;
   return DM_TRAJ_NONE;
 }
@@ -670,8 +681,9 @@ static int valid_key(const char *key)
   return 1;
 }
 
-int dm_traj_meta_set(dm_traj *tr, const char *key, const char *value,
-                     dm_err *e)
+/* Set key to the string value (isnum 0) or the number x (value: its text). */
+static int meta_put(dm_traj *tr, const char *key, const char *value, int isnum, double x,
+                    dm_err *e)
 {
   size_t i;
   char *dk, *dv;
@@ -683,47 +695,67 @@ int dm_traj_meta_set(dm_traj *tr, const char *key, const char *value,
   if (value == NULL) {                       /* remove */
     if (i == DM_TRAJ_NONE)
       return DM_OK;
-    free(tr->mkey[i]);
-    free(tr->mval[i]);
-    memmove(tr->mkey + i, tr->mkey + i + 1, (tr->nmeta - i - 1) * sizeof(char *));
-    memmove(tr->mval + i, tr->mval + i + 1, (tr->nmeta - i - 1) * sizeof(char *));
+    free(tr->m[i].key);
+    free(tr->m[i].val);
+    memmove(tr->m + i, tr->m + i + 1, (tr->nmeta - i - 1) * sizeof *tr->m);
     tr->nmeta--;
     return DM_OK;
   }
   if ((dv = dupstr(value)) == NULL)
     return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
-  if (i != DM_TRAJ_NONE) {
-    free(tr->mval[i]);
-    tr->mval[i] = dv;
-    return DM_OK;
-  }
-  if (tr->nmeta == tr->metacap) {
-    size_t nc = tr->metacap ? 2 * tr->metacap : 8;
-    char **k2 = realloc(tr->mkey, nc * sizeof *k2), **v2;
-    if (k2 != NULL)
-      tr->mkey = k2;
-    v2 = k2 != NULL ? realloc(tr->mval, nc * sizeof *v2) : NULL;
-    if (v2 == NULL) {
+  if (i == DM_TRAJ_NONE) {
+    if (tr->nmeta == tr->metacap) {
+      size_t nc = tr->metacap ? 2 * tr->metacap : 8;
+      meta *m2 = realloc(tr->m, nc * sizeof *m2);
+      if (m2 == NULL) {
+        free(dv);
+        return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
+      }
+      tr->m = m2;
+      tr->metacap = nc;
+    }
+    if ((dk = dupstr(key)) == NULL) {
       free(dv);
       return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
     }
-    tr->mval = v2;
-    tr->metacap = nc;
+    i = tr->nmeta++;
+    tr->m[i].key = dk;
+  } else {
+    free(tr->m[i].val);
   }
-  if ((dk = dupstr(key)) == NULL) {
-    free(dv);
-    return dm_err_set(e, DM_ENOMEM, "metadata: out of memory");
-  }
-  tr->mkey[tr->nmeta] = dk;
-  tr->mval[tr->nmeta] = dv;
-  tr->nmeta++;
+  tr->m[i].val = dv;
+  tr->m[i].isnum = isnum;
+  tr->m[i].x = x;
   return DM_OK;
+}
+
+int dm_traj_meta_set(dm_traj *tr, const char *key, const char *value,
+                     dm_err *e)
+{
+  return meta_put(tr, key, value, 0, 0.0, e);
+}
+
+int dm_traj_meta_set_number(dm_traj *tr, const char *key, double x, dm_err *e)
+{
+  char buf[DM_NUM_BUFSIZE];
+  dm_num_format(buf, sizeof buf, x);
+  return meta_put(tr, key, buf, 1, x, e);
 }
 
 const char *dm_traj_meta_get(const dm_traj *tr, const char *key)
 {
   size_t i = key != NULL ? meta_find(tr, key) : DM_TRAJ_NONE;
-  return i != DM_TRAJ_NONE ? tr->mval[i] : NULL;
+  return i != DM_TRAJ_NONE ? tr->m[i].val : NULL;
+}
+
+int dm_traj_meta_number(const dm_traj *tr, const char *key, double *x)
+{
+  size_t i = key != NULL ? meta_find(tr, key) : DM_TRAJ_NONE;
+  if (i == DM_TRAJ_NONE || !tr->m[i].isnum)
+    return 0;
+  if (x != NULL)
+    *x = tr->m[i].x;
+  return 1;
 }
 
 size_t dm_traj_meta_count(const dm_traj *tr) { return tr->nmeta; }
@@ -734,10 +766,19 @@ int dm_traj_meta_at(const dm_traj *tr, size_t i, const char **key,
   if (i >= tr->nmeta)
     return DM_EINVAL;
   if (key != NULL)
-    *key = tr->mkey[i];
+    *key = tr->m[i].key;
   if (value != NULL)
-    *value = tr->mval[i];
+    *value = tr->m[i].val;
   return DM_OK;
+}
+
+int dm_traj_meta_number_at(const dm_traj *tr, size_t i, double *x)
+{
+  if (i >= tr->nmeta || !tr->m[i].isnum)
+    return 0;
+  if (x != NULL)
+    *x = tr->m[i].x;
+  return 1;
 }
 
 /* }==== */

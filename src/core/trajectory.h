@@ -4,8 +4,8 @@
  * the coordinates q, optionally the momenta p and the velocities v, then any
  * number of extra columns (diagnostics filled by the integrator binding,
  * derived columns computed by a callback, plain data).  It also carries
- * metadata: an ordered list of key=value strings (system name, method, h,
- * parameters, ...).
+ * metadata: an ordered list of key=value pairs whose values are strings or
+ * numbers (system name, method, h, parameters, how the run ended, ...).
  *
  * Column layout and names (fixed order):
  *   0                 "t"
@@ -22,9 +22,11 @@
  * Samples are indexed 0 .. len-1 in C (the Lua binding is 1-based).
  *
  * Metadata keys producers should use (the Lua __tostring shows the first
- * four): "system" (name), "method", "stages", "h", and "param.<name>" for
- * each system parameter; values are strings (numbers written "%.17g" or
- * shortest round-trip form).
+ * four): "system" (name, a string), "method" (a string), "stages", "h" (numbers),
+ * and "param.<name>" (a number) for each system parameter; the run driver
+ * (run.h) adds "order", "steps", "status" (numbers) and "message" (a string).
+ * A number keeps its double value; its text (dm_traj_meta_get) is the
+ * shortest round-trip form in the C locale.
  *
  * Ownership: dm_traj_alloc / dm_traj_load / dm_traj_slice return a new
  * trajectory the caller releases with dm_traj_free (NULL is a no-op).  The
@@ -209,21 +211,30 @@ dm_traj *dm_traj_slice(const dm_traj *tr, size_t i, size_t j, size_t stride,
  * first insertion is kept. */
 int dm_traj_meta_set(dm_traj *tr, const char *key, const char *value,
                      dm_err *e);
-/* Value of key or NULL. */
+/* Set key to the number x (its text: shortest round-trip form). */
+int dm_traj_meta_set_number(dm_traj *tr, const char *key, double x, dm_err *e);
+/* Value of key as text (numbers formatted) or NULL. */
 const char *dm_traj_meta_get(const dm_traj *tr, const char *key);
+/* 1 and *x (may be NULL) = the value when key holds a number, else 0 (absent
+ * or a string). */
+int dm_traj_meta_number(const dm_traj *tr, const char *key, double *x);
 size_t dm_traj_meta_count(const dm_traj *tr);
 /* The i-th pair (i < count): DM_OK, else DM_EINVAL. */
 int dm_traj_meta_at(const dm_traj *tr, size_t i, const char **key,
                     const char **value);
+/* 1 and *x when the i-th value is a number, else 0. */
+int dm_traj_meta_number_at(const dm_traj *tr, size_t i, double *x);
 
 /* ---- files ---------------------------------------------------------------------- */
 
 /* CSV format (comment lines start with '#'):
- *   # dmech trajectory 1
- *   # meta <key>=<value, with \\ \n \r \t \xHH escapes>      (0 or more)
+ *   # dmech trajectory 2
+ *   # meta <key>=<value, with \\ \n \r \t \xHH escapes>      (string values)
+ *   # number <key>=<shortest round-trip number>              (numeric values)
  *   # kinds t,q,q,p,p,v,v,diag,derived                      (one per column)
  *   t,r,theta,p_r,p_theta,v_r,v_theta,energy,x
  *   0,2,0,...                                               (%.17g)
+ * Version 1 files (no "# number" lines) load with every value a string.
  * dm_traj_load also reads a plain CSV whose first line is a header starting
  * with "t" (other '#' lines are skipped): every other column becomes a
  * DM_TRAJ_DATA column.  Errors name the file, the line and what was expected.

@@ -1,13 +1,13 @@
 /* trajectory_csv.c -- trajectories to and from CSV files (format in
  * trajectory.h).  Numbers are written with "%.17g" and read with strtod,
- * both in a private "C" numeric locale selected with uselocale() for this
- * thread only, so the user's LC_NUMERIC (a decimal comma) never matters. */
+ * both in the "C" locale of numfmt.h selected for this thread only, so the
+ * user's LC_NUMERIC (a decimal comma) never matters. */
 #include <config.h>
 #include "core/trajectory.h"
 
 #include <errno.h>
 #include <fcntl.h>
-#include <locale.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,34 +16,11 @@
 #include <unistd.h>
 
 #include "core/interrupt.h"
+#include "core/numfmt.h"
 
 #define MAGIC "# dmech trajectory "
-#define FORMAT_VERSION 1
+#define FORMAT_VERSION 2     /* 2: numeric metadata ("# number"); 1 without */
 #define POLL_EVERY 4096
-
-/* {==== the C numeric locale ============================================ */
-
-typedef struct c_numeric {
-  locale_t c, old;
-} c_numeric;
-
-static int c_numeric_enter(c_numeric *cn, dm_err *e)
-{
-  cn->c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-  if (cn->c == (locale_t)0)
-    return dm_err_set(e, DM_ENOMEM, "cannot create the C numeric locale: %s",
-                      strerror(errno));
-  cn->old = uselocale(cn->c);
-  return DM_OK;
-}
-
-static void c_numeric_leave(c_numeric *cn)
-{
-  uselocale(cn->old);
-  freelocale(cn->c);
-}
-
-/* }==== */
 
 /* {==== writing ============================================================ */
 
@@ -69,11 +46,15 @@ static void put_escaped(FILE *f, const char *s)
 static void write_head(const dm_traj *tr, FILE *f)
 {
   size_t i, nc = dm_traj_ncols(tr);
-  fprintf(f, MAGIC "%d\n", FORMAT_VERSION);
+  int version = 1;
+  for (i = 0; i < dm_traj_meta_count(tr); i++)
+    if (dm_traj_meta_number_at(tr, i, NULL))
+      version = FORMAT_VERSION;
+  fprintf(f, MAGIC "%d\n", version);
   for (i = 0; i < dm_traj_meta_count(tr); i++) {
     const char *k, *v;
     dm_traj_meta_at(tr, i, &k, &v);
-    fprintf(f, "# meta %s=", k);
+    fprintf(f, dm_traj_meta_number_at(tr, i, NULL) ? "# number %s=" : "# meta %s=", k);
     put_escaped(f, v);
     fputc('\n', f);
   }
@@ -104,16 +85,15 @@ static int write_body(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
 
 int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
 {
-  c_numeric cn;
+  locale_t old;
   int st;
   if (name == NULL)
     name = "(stream)";
-  if ((st = c_numeric_enter(&cn, e)) != DM_OK)
-    return st;
+  old = dm_num_enter();
   errno = 0;
   write_head(tr, f);
   st = write_body(tr, f, name, e);
-  c_numeric_leave(&cn);
+  dm_num_leave(old);
   if (st == DM_OK && (fflush(f) != 0 || ferror(f)))
     st = dm_err_set(e, DM_EIO, "writing '%.200s': %s", name,
                     strerror(errno ? errno : EIO));
@@ -349,6 +329,8 @@ typedef struct preamble {
   char *kinds;             /* copy of the kinds list, or NULL */
   size_t kinds_line;
   char **mkey, **mval;     /* metadata in file order */
+  double *mx;              /* numeric values (NaN for strings) */
+  unsigned char *misnum;
   size_t nmeta;
 } preamble;
 
@@ -361,18 +343,27 @@ static void preamble_free(preamble *pr)
   }
   free(pr->mkey);
   free(pr->mval);
+  free(pr->mx);
+  free(pr->misnum);
   free(pr->kinds);
 }
 
-static int read_meta(reader *r, preamble *pr, const char *text)
+/* "# meta key=value" (isnum 0) or "# number key=value" (isnum 1) */
+static int read_meta(reader *r, preamble *pr, const char *text, int isnum)
 {
-  const char *eq = strchr(text, '=');
-  char *k, *v, **nk, **nv;
+  const char *eq = strchr(text, '='), *what = isnum ? "number" : "meta";
+  char *k, *v, **nk, **nv, *end;
+  double *nx, x = NAN;
+  unsigned char *nn;
   size_t i;
   int st;
   if (eq == NULL || eq == text)
-    return fail_at(r, "expected '# meta key=value', got '# meta %.200s'%s",
-                   text, "");
+    return fail_at(r, "expected '# %s key=value', got '%.200s'", what, r->line);
+  if (isnum) {
+    x = dm_num_parse(eq + 1, &end);
+    if (end == eq + 1 || *end != '\0')
+      return fail_at(r, "'# number' value '%.60s' is not a number%s", eq + 1, "");
+  }
   k = strndup(text, (size_t)(eq - text));
   v = strdup(eq + 1);
   nk = realloc(pr->mkey, (pr->nmeta + 1) * sizeof *nk);
@@ -381,7 +372,13 @@ static int read_meta(reader *r, preamble *pr, const char *text)
   nv = nk != NULL ? realloc(pr->mval, (pr->nmeta + 1) * sizeof *nv) : NULL;
   if (nv != NULL)
     pr->mval = nv;
-  if (k == NULL || v == NULL || nv == NULL) {
+  nx = nv != NULL ? realloc(pr->mx, (pr->nmeta + 1) * sizeof *nx) : NULL;
+  if (nx != NULL)
+    pr->mx = nx;
+  nn = nx != NULL ? realloc(pr->misnum, pr->nmeta + 1) : NULL;
+  if (nn != NULL)
+    pr->misnum = nn;
+  if (k == NULL || v == NULL || nn == NULL) {
     free(k);
     free(v);
     return dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
@@ -395,8 +392,10 @@ static int read_meta(reader *r, preamble *pr, const char *text)
     }
   pr->mkey[pr->nmeta] = k;
   pr->mval[pr->nmeta] = v;
+  pr->mx[pr->nmeta] = x;
+  pr->misnum[pr->nmeta] = (unsigned char)isnum;
   pr->nmeta++;
-  return unescape(r, v);
+  return isnum ? DM_OK : unescape(r, v);
 }
 
 /* One '#' line before the header. */
@@ -405,14 +404,16 @@ static int read_comment(reader *r, preamble *pr)
   const char *s = r->line;
   if (strncmp(s, MAGIC, strlen(MAGIC)) == 0) {
     const char *ver = s + strlen(MAGIC);
-    if (strcmp(ver, "1") != 0)
+    if (strcmp(ver, "1") != 0 && strcmp(ver, "2") != 0)
       return fail_at(r, "unsupported trajectory format version '%.50s' (this "
-                     "dmech reads version 1)%s", ver, "");
-    pr->magic = 1;
+                     "dmech reads versions 1 and 2)%s", ver, "");
+    pr->magic = ver[0] - '0';
     return DM_OK;
   }
   if (strncmp(s, "# meta ", 7) == 0)
-    return read_meta(r, pr, s + 7);
+    return read_meta(r, pr, s + 7, 0);
+  if (strncmp(s, "# number ", 9) == 0 && pr->magic >= 2)
+    return read_meta(r, pr, s + 9, 1);
   if (strncmp(s, "# kinds ", 8) == 0) {
     if (pr->kinds != NULL) {
       char a[32];
@@ -522,7 +523,8 @@ static dm_traj *make_traj(reader *r, preamble *pr, size_t *ncols)
       tr = NULL;
     }
   for (i = 0; tr != NULL && i < pr->nmeta; i++)
-    if ((st = dm_traj_meta_set(tr, pr->mkey[i], pr->mval[i], r->e)) != DM_OK) {
+    if ((st = pr->misnum[i] ? dm_traj_meta_set_number(tr, pr->mkey[i], pr->mx[i], r->e)
+                            : dm_traj_meta_set(tr, pr->mkey[i], pr->mval[i], r->e)) != DM_OK) {
       dm_traj_free(tr);
       tr = NULL;
     }
@@ -614,7 +616,6 @@ dm_traj *dm_traj_load(const char *path, dm_err *e)
   reader r = {0};
   preamble pr = {0};
   dm_traj *tr = NULL;
-  c_numeric cn;
   size_t nc = 0;
   int got, st = DM_OK;
   r.path = path != NULL ? path : "";
@@ -634,11 +635,10 @@ dm_traj *dm_traj_load(const char *path, dm_err *e)
     fail_at(&r, "empty line where the header was expected ('t,...')%s%s", "", "");
   else if (st == DM_OK && got > 0)
     tr = make_traj(&r, &pr, &nc);
-  if (tr != NULL && c_numeric_enter(&cn, e) == DM_OK) {
+  if (tr != NULL) {
+    locale_t old = dm_num_enter();
     st = read_rows(&r, tr, nc);
-    c_numeric_leave(&cn);
-  } else if (tr != NULL) {
-    st = e != NULL ? e->status : DM_ENOMEM;
+    dm_num_leave(old);
   }
   if (st != DM_OK) {
     dm_traj_free(tr);

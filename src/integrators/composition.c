@@ -225,11 +225,17 @@ static void comp_reset(dm_integrator *I)
 }
 
 const dm_integrator_type dm_integ_composition = {
-  "composition",
-  "symmetric composition of the trapezoid (Stormer-Verlet) or midpoint step: order 4, 6, 8 "
-  "(yoshida4, yoshida6, kahanli6, mclachlan8, kahanli8)",
-  0,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS,
-  comp_options,
-  comp_alloc, comp_step, comp_jacobian, NULL, comp_advance, comp_reset, comp_free
+  .name = "composition",
+  .summary = "symmetric composition of the trapezoid (Stormer-Verlet) or midpoint step: order 4, 6, 8 "
+    "(yoshida4, yoshida6, kahanli6, mclachlan8, kahanli8)",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS,
+  .options = comp_options,
+  .alloc = comp_alloc,
+  .step = comp_step,
+  .jacobian = comp_jacobian,
+  .dlegendre = NULL,
+  .advance = comp_advance,
+  .reset = comp_reset,
+  .free = comp_free,
 };

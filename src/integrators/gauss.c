@@ -72,24 +72,34 @@ static int midpoint_dlegendre(dm_integrator *I, double h, const double *q0, cons
 }
 
 const dm_integrator_type dm_integ_midpoint = {
-  "midpoint",
-  "implicit midpoint = Gauss 1, L_d = h L((q0+q1)/2, (q1-q0)/h); order 2, symmetric, symplectic",
-  2,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
+  .name = "midpoint",
+  .summary = "implicit midpoint = Gauss 1, L_d = h L((q0+q1)/2, (q1-q0)/h); order 2, symmetric, symplectic",
+  .order = 2,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  midpoint_options,
-  midpoint_alloc, dm_prk_type_step, dm_prk_type_jacobian, midpoint_dlegendre,
-  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
+  .options = midpoint_options,
+  .alloc = midpoint_alloc,
+  .step = dm_prk_type_step,
+  .jacobian = dm_prk_type_jacobian,
+  .dlegendre = midpoint_dlegendre,
+  .advance = dm_prk_type_advance,
+  .reset = dm_prk_type_reset,
+  .free = dm_prk_type_free,
 };
 
 const dm_integrator_type dm_integ_gauss = {
-  "gauss",
-  "Gauss-Legendre Galerkin integrator with s stages (default 2); order 2s, symmetric, symplectic "
-  "(constraints only with s = 1)",
-  0,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
+  .name = "gauss",
+  .summary = "Gauss-Legendre Galerkin integrator with s stages (default 2); order 2s, symmetric, symplectic "
+    "(constraints only with s = 1)",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  gauss_options,
-  gauss_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
+  .options = gauss_options,
+  .alloc = gauss_alloc,
+  .step = dm_prk_type_step,
+  .jacobian = dm_prk_type_jacobian,
+  .dlegendre = dm_prk_type_dlegendre,
+  .advance = dm_prk_type_advance,
+  .reset = dm_prk_type_reset,
+  .free = dm_prk_type_free,
 };

@@ -162,10 +162,16 @@ static void gsl_reset(dm_integrator *I)
 }
 
 const dm_integrator_type dm_integ_gsl = {
-  "gsl",
-  "GSL odeiv2 stepper gsl:<name> on (q, p) (non-symplectic reference; fixed or adaptive steps)",
-  0,
-  DM_INTEG_FORCES,
-  gsl_options,
-  gsl_alloc, gsl_step, NULL, NULL, NULL, gsl_reset, gsl_free_state
+  .name = "gsl",
+  .summary = "GSL odeiv2 stepper gsl:<name> on (q, p) (non-symplectic reference; fixed or adaptive steps)",
+  .order = 0,
+  .flags = DM_INTEG_FORCES,
+  .options = gsl_options,
+  .alloc = gsl_alloc,
+  .step = gsl_step,
+  .jacobian = NULL,
+  .dlegendre = NULL,
+  .advance = NULL,
+  .reset = gsl_reset,
+  .free = gsl_free_state,
 };

@@ -109,15 +109,56 @@ int dm_integ_opts_get(const dm_integ_opts *o, const char *name, double *num,
 
 /* {==== life cycle ======================================================= */
 
-static int known_methods(char *buf, size_t len)
+/* "a, b, gsl:<stepper>" -- the methods for a kind -- into buf */
+static void known_methods(const char *kind, char *buf, size_t len)
 {
-  const dm_integrator_type *const *t = dm_integrator_types();
-  size_t k = 0;
+  size_t i, k = 0, count = dm_integrator_count();
   buf[0] = '\0';
-  for (; *t && k < len; t++)
-    k += (size_t)snprintf(buf + k, len - k, "%s%s%s", k ? ", " : "", (*t)->name,
-                          strcmp((*t)->name, "gsl") == 0 ? ":<stepper>" : "");
-  return 0;
+  for (i = 0; i < count && k < len; i++) {
+    const dm_integrator_type *t = dm_integrator_type_at(i);
+    const char *const *a;
+    if (!dm_integrator_accepts(t, kind))
+      continue;
+    k += (size_t)snprintf(buf + k, len - k, "%s%s%s", k ? ", " : "", t->name,
+                          strcmp(t->name, "gsl") == 0 ? ":<stepper>" : "");
+    for (a = t->names; a != NULL && *a != NULL && k < len; a++)
+      k += (size_t)snprintf(buf + k, len - k, ", %s", *a);
+  }
+}
+
+/* DM_ENOTFOUND for a method no family of sys's kind answers to: say which
+ * kinds it does apply to, if any */
+static const dm_integrator_type *not_found(const dm_system *sys, const char *method, dm_err *e)
+{
+  const char *kind = sys->kind ? sys->kind : DM_SYSTEM_LAGRANGIAN;
+  char buf[400], kinds[160];
+  size_t i, k = 0, count = dm_integrator_count();
+  kinds[0] = '\0';
+  for (i = 0; i < count && k < sizeof kinds; i++) {
+    const dm_integrator_type *t = dm_integrator_type_at(i);
+    const char *const lag[] = {DM_SYSTEM_LAGRANGIAN, NULL}, *const *kk;
+    if (dm_integrator_find(t->kinds ? t->kinds[0] : NULL, method, NULL) != t)
+      continue;
+    for (kk = t->kinds ? t->kinds : lag; *kk != NULL && k < sizeof kinds; kk++)
+      if (strstr(kinds, *kk) == NULL)
+        k += (size_t)snprintf(kinds + k, sizeof kinds - k, "%s%s", k ? ", " : "", *kk);
+  }
+  known_methods(kind, buf, sizeof buf);
+  if (kinds[0] != '\0')
+    dm_err_set(e, DM_ENOTFOUND, "method '%s' does not apply to system '%s' (a %s system); it "
+               "integrates %s systems (methods here: %s)", method, sys->name ? sys->name : "?",
+               kind, kinds, buf);
+  else
+    dm_err_set(e, DM_ENOTFOUND, "unknown integration method '%s' (known: %s)",
+               method ? method : "(null)", buf);
+  return NULL;
+}
+
+const dm_integrator_type *dm_integrator_select(const dm_system *sys, const char *method,
+                                               const char **variant_out, dm_err *e)
+{
+  const dm_integrator_type *t = dm_integrator_find(sys->kind, method, variant_out);
+  return t != NULL ? t : not_found(sys, method, e);
 }
 
 int dm_integrator_new(const dm_system *sys, const char *method,
@@ -134,12 +175,8 @@ int dm_integrator_new(const dm_system *sys, const char *method,
   if (sys->m > 0 && sys->constraints == NULL)
     return dm_err_set(e, DM_EINVAL, "system '%s' declares %zu constraints but no constraint function",
                       sys->name ? sys->name : "?", sys->m);
-  if ((type = dm_integrator_lookup(method, &variant)) == NULL) {
-    char buf[256];
-    known_methods(buf, sizeof buf);
-    return dm_err_set(e, DM_ENOTFOUND, "unknown integration method '%s' (known: %s)",
-                      method ? method : "(null)", buf);
-  }
+  if ((type = dm_integrator_select(sys, method, &variant, e)) == NULL)
+    return DM_ENOTFOUND;
   if (sys->m > 0 && !(type->flags & DM_INTEG_CONSTRAINTS))
     return dm_err_set(e, DM_EUNSUP, "method '%s' does not support holonomic constraints "
                       "(use lobatto, trapezoid or midpoint)", method);
@@ -286,7 +323,7 @@ static int emit(dm_integrator *I, dm_sink_fn sink, void *ctx, double t, const do
   if ((st = dm_legendre_velocity(I->leg, q, p, v, *nsamples > 0, e)) != DM_OK)
     return st;
   if ((st = sink(ctx, t, q, p, v)) != 0)
-    return dm_err_set(e, st > 0 && st <= DM_EFAILED ? st : DM_ECALLBACK,
+    return dm_err_set(e, st > 0 && st < DM_NSTATUS ? st : DM_ECALLBACK,
                       "the sample sink stopped the run at t = %.17g (%s)", t,
                       dm_strstatus(st > 0 ? st : DM_ECALLBACK));
   (*nsamples)++;
@@ -314,6 +351,13 @@ static int advance_steps(dm_integrator *I, double h, long nsteps, double *q, dou
   }
   *done = k;
   return st;
+}
+
+int dm_integrator_advance(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                          long *done, dm_err *e)
+{
+  return I->type->advance ? I->type->advance(I, h, nsteps, q, p, done, e)
+                          : advance_steps(I, h, nsteps, q, p, done, e);
 }
 
 int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double h,
@@ -344,8 +388,7 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
     long chunk = every - k % every, got = 0;
     if (chunk > nsteps - k)
       chunk = nsteps - k;
-    st = I->type->advance ? I->type->advance(I, h, chunk, q, p, &got, &le)
-                          : advance_steps(I, h, chunk, q, p, &got, &le);
+    st = dm_integrator_advance(I, h, chunk, q, p, &got, &le);
     k += got;
     if (st == DM_EINTR) {
       dm_err_set(e, DM_EINTR, "interrupted after step %ld of %ld (t = %.17g); the trajectory "

@@ -1,21 +1,33 @@
 /* integrator.h -- one-step integrators for a dm_system, selected by name.
  *
  * Every method family is a `const dm_integrator_type` (GSL ode-initval2
- * style) in its own file under src/integrators/; registry.c lists them.
- * A new method is one file plus one line there.  Method names:
+ * style) in its own file.  The families of this directory are listed in
+ * registry.c; other modules add theirs with dm_integrator_register (the
+ * Routh reduction registers RSPRK, the discrete Routh equations and the
+ * classical Routhian for its reduced systems).  A family declares which
+ * system kinds it integrates (dm_system.kind): the method name is looked up
+ * among the families for the system's kind, so "gauss" is the Gauss PRK on
+ * a Lagrangian system and RSPRK on the reduced system of a Routh reduction.
+ * Method names of the Lagrangian kind:
  *   midpoint, gauss (stages >= 1), trapezoid, lobatto (IIIA-IIIB, stages >= 2),
  *   prk (user tableau), composition (symmetric compositions of order 4/6/8),
  *   rk4 (classical, non-symplectic), gsl:<stepper> (GSL odeiv2).
  *
  * State.  The primary state is (q, p), p = dL/dv.  step() maps (q0, p0) to
  * (q1, p1) over a step h of either sign.  Conversions to (q, v) and to the
- * two-point (q0, q1) form are below (discrete Legendre transforms).
+ * two-point (q0, q1) form are below (discrete Legendre transforms).  Runs
+ * into a trajectory are core/run.h.
  *
  * Ownership.  dm_integrator_new() allocates the integrator and every
  * workspace any later step needs (a step never calls malloc); the system is
  * borrowed and must outlive the integrator; dm_integrator_free() releases
- * everything (NULL is a no-op).  One integrator must not be used by two
- * threads at once; two integrators on one system may.
+ * everything (NULL is a no-op).  Registered types are borrowed for the life
+ * of the process.
+ *
+ * Thread safety.  One integrator must not be used by two threads at once;
+ * two integrators on one system may (systems keep no state between calls).
+ * Registration may run concurrently with lookups and dm_integrator_new:
+ * entries are published atomically and never removed.
  *
  * Errors.  Functions return DM_OK or a DM_E* status and fill the dm_err (may
  * be NULL): DM_ENOCONV (Newton did not converge; residual and tolerance in
@@ -121,6 +133,12 @@ typedef struct dm_integrator_type {
   /* Forget step history (predictor, compensated-summation carries). */
   void (*reset)(dm_integrator *I);
   void (*free)(dm_integrator *I);
+  /* The system kinds (dm_system.kind) this family integrates, NULL-ended;
+   * NULL: Lagrangian systems (DM_SYSTEM_LAGRANGIAN) only. */
+  const char *const *kinds;
+  /* Further method names the family answers to besides `name` (the
+   * instance sees the one requested in I->name), NULL-ended; may be NULL. */
+  const char *const *names;
 } dm_integrator_type;
 
 /* Statistics of the last step and running totals. */
@@ -141,6 +159,9 @@ struct dm_integrator {
   char variant[DM_INTEG_STRMAX];   /* text after "name:" (gsl stepper) */
   char name[2 * DM_INTEG_STRMAX];  /* full method name as requested */
   int order;                       /* actual order of this instance */
+  int stages;                      /* stages of a Runge-Kutta / Galerkin method
+                                    * (midpoint 1, trapezoid 2, gauss s, ...);
+                                    * 0 when the notion does not apply */
   unsigned flags;                  /* actual dm_integ_flags */
   dm_integ_stats stats;
   void *state;                     /* family private */
@@ -150,13 +171,43 @@ struct dm_integrator {
 
 /* {==== registry and life cycle ========================================== */
 
-/* Type for a method name ("gauss", "gsl:rk8pd" -> the gsl type); NULL if
- * unknown.  *variant_out (may be NULL) points into name after ':'. */
-const dm_integrator_type *dm_integrator_lookup(const char *name, const char **variant_out);
-/* The registered types, NULL-terminated. */
-const dm_integrator_type *const *dm_integrator_types(void);
+/* Add a family to the registry (idempotent for the same type object).
+ * DM_EINVAL when the type lacks a name, step or alloc, or when another
+ * registered family already answers to one of its names for one of its
+ * kinds; DM_ENOMEM when the registry is full (DM_INTEG_REGISTRY_MAX). */
+#define DM_INTEG_REGISTRY_MAX 64
+int dm_integrator_register(const dm_integrator_type *type, dm_err *e);
 
-/* Create an integrator for sys with method name and options (NULL: defaults).
+/* The registered families, in registration order (the families of this
+ * directory first): their count, and the i-th (NULL when i >= count). */
+size_t dm_integrator_count(void);
+const dm_integrator_type *dm_integrator_type_at(size_t i);
+
+/* Does the family read option `name` (listed in type->options)? */
+int dm_integrator_has_option(const dm_integrator_type *type, const char *name);
+/* Is the stage count of I a choice (a "stages" or "tableau" option), so that
+ * it belongs in a description of the run (midpoint and trapezoid: no)? */
+int dm_integrator_stages_chosen(const dm_integrator *I);
+
+/* Does the family integrate systems of this kind (NULL: Lagrangian)? */
+int dm_integrator_accepts(const dm_integrator_type *type, const char *kind);
+
+/* The family answering to a method name for a system kind (NULL:
+ * Lagrangian): "gauss", "gsl:rk8pd" (the gsl family, variant "rk8pd"),
+ * "dr:gauss" (kind "routh").  NULL if none.  *variant_out (may be NULL)
+ * points into name after the family's name and ':' (NULL if none). */
+const dm_integrator_type *dm_integrator_find(const char *kind, const char *name,
+                                             const char **variant_out);
+/* The family for sys->kind and method, or NULL and DM_ENOTFOUND in e with
+ * the methods of that kind, or the kinds the method applies to. */
+const dm_integrator_type *dm_integrator_select(const dm_system *sys, const char *method,
+                                               const char **variant_out, dm_err *e);
+/* dm_integrator_find for Lagrangian systems. */
+const dm_integrator_type *dm_integrator_lookup(const char *name, const char **variant_out);
+
+/* Create an integrator for sys with method name and options (NULL: defaults);
+ * the family is the one answering to the name for sys->kind.  DM_ENOTFOUND
+ * names the methods of that kind, or the kinds the method applies to.
  * On error *out is NULL and nothing is leaked. */
 int dm_integrator_new(const dm_system *sys, const char *method,
                       const dm_integ_opts *opts, dm_integrator **out, dm_err *e);
@@ -196,6 +247,13 @@ int dm_integrator_discrete_momentum(dm_integrator *I, double h, const double *q0
                                     dm_err *e);
 
 /* {==== runs ============================================================= */
+
+/* Up to nsteps steps of h in place on (q, p) through the family's fast
+ * path (or step() repeatedly), polling dm_interrupted() before each step
+ * (DM_EINTR, no message).  *done = steps completed; on failure q, p hold
+ * the state after *done steps and e the failing step's own message. */
+int dm_integrator_advance(dm_integrator *I, double h, long nsteps, double *q, double *p,
+                          long *done, dm_err *e);
 
 /* Sample sink supplied by the trajectory module: return 0 to continue,
  * non-zero to stop the run (DM_ECALLBACK). */

@@ -38,25 +38,35 @@ static int trapezoid_alloc(dm_integrator *I, dm_err *e)
 }
 
 const dm_integrator_type dm_integ_trapezoid = {
-  "trapezoid",
-  "trapezoid = Lobatto IIIA-IIIB 2, L_d = h/2 [L(q0,v) + L(q1,v)]; explicit Stormer-Verlet "
-  "(RATTLE with constraints) for separable L; order 2",
-  2,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
+  .name = "trapezoid",
+  .summary = "trapezoid = Lobatto IIIA-IIIB 2, L_d = h/2 [L(q0,v) + L(q1,v)]; explicit Stormer-Verlet "
+    "(RATTLE with constraints) for separable L; order 2",
+  .order = 2,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  trapezoid_options,
-  trapezoid_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
+  .options = trapezoid_options,
+  .alloc = trapezoid_alloc,
+  .step = dm_prk_type_step,
+  .jacobian = dm_prk_type_jacobian,
+  .dlegendre = dm_prk_type_dlegendre,
+  .advance = dm_prk_type_advance,
+  .reset = dm_prk_type_reset,
+  .free = dm_prk_type_free,
 };
 
 const dm_integrator_type dm_integ_lobatto = {
-  "lobatto",
-  "Lobatto IIIA-IIIB Galerkin integrator with s stages (default 3); order 2s-2, symmetric, "
-  "symplectic; constraints with multipliers at every stage",
-  0,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
+  .name = "lobatto",
+  .summary = "Lobatto IIIA-IIIB Galerkin integrator with s stages (default 3); order 2s-2, symmetric, "
+    "symplectic; constraints with multipliers at every stage",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_SYMMETRIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES
     | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  lobatto_options,
-  lobatto_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
+  .options = lobatto_options,
+  .alloc = lobatto_alloc,
+  .step = dm_prk_type_step,
+  .jacobian = dm_prk_type_jacobian,
+  .dlegendre = dm_prk_type_dlegendre,
+  .advance = dm_prk_type_advance,
+  .reset = dm_prk_type_reset,
+  .free = dm_prk_type_free,
 };

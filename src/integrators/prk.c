@@ -22,11 +22,16 @@ static int prk_alloc(dm_integrator *I, dm_err *e)
 }
 
 const dm_integrator_type dm_integ_prk = {
-  "prk",
-  "symplectic partitioned Runge-Kutta method from a user tableau (a, b, at)",
-  0,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
-  prk_options,
-  prk_alloc, dm_prk_type_step, dm_prk_type_jacobian, dm_prk_type_dlegendre,
-  dm_prk_type_advance, dm_prk_type_reset, dm_prk_type_free
+  .name = "prk",
+  .summary = "symplectic partitioned Runge-Kutta method from a user tableau (a, b, at)",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
+  .options = prk_options,
+  .alloc = prk_alloc,
+  .step = dm_prk_type_step,
+  .jacobian = dm_prk_type_jacobian,
+  .dlegendre = dm_prk_type_dlegendre,
+  .advance = dm_prk_type_advance,
+  .reset = dm_prk_type_reset,
+  .free = dm_prk_type_free,
 };

@@ -614,6 +614,7 @@ int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
   I->state = P;
   P->simplified = I->opt.simplified;
   I->order = t->order;
+  I->stages = (int)t->s;
   I->flags = DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;
   if (I->m == 0)
     I->flags |= DM_INTEG_EXACT_JAC;

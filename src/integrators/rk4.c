@@ -117,10 +117,16 @@ static int rk4_jacobian(dm_integrator *I, double h, const double *q0, const doub
 }
 
 const dm_integrator_type dm_integ_rk4 = {
-  "rk4",
-  "classical 4th-order Runge-Kutta on (q, p) (non-symplectic reference)",
-  4,
-  DM_INTEG_EXPLICIT | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
-  rk4_options,
-  rk4_alloc, rk4_step, rk4_jacobian, NULL, NULL, NULL, rk4_free
+  .name = "rk4",
+  .summary = "classical 4th-order Runge-Kutta on (q, p) (non-symplectic reference)",
+  .order = 4,
+  .flags = DM_INTEG_EXPLICIT | DM_INTEG_FORCES | DM_INTEG_EXACT_JAC,
+  .options = rk4_options,
+  .alloc = rk4_alloc,
+  .step = rk4_step,
+  .jacobian = rk4_jacobian,
+  .dlegendre = NULL,
+  .advance = NULL,
+  .reset = NULL,
+  .free = rk4_free,
 };

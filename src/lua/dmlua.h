@@ -22,6 +22,7 @@
 #include <gsl/gsl_vector.h>
 
 #include "core/status.h"
+#include "core/numfmt.h"   /* dm_num_format: numbers as the bindings print them */
 
 #define DM_VEC_MT "dmech.vec"
 #define DM_MAT_MT "dmech.mat"
@@ -74,10 +75,6 @@ lua_Integer dm_optintegerfield(lua_State *L, int t, const char *key,
                                lua_Integer def);
 const char *dm_optstringfield(lua_State *L, int t, const char *key,
                               const char *def);
-
-/* Shortest decimal that reads back as exactly x ("2.385", "0.1", "1e-300"),
- * locale independent; returns the length. */
-int dm_fmtnum(char *buf, size_t size, double x);
 
 /* ---- vectors and matrices -------------------------------------------------- */
 
@@ -135,7 +132,10 @@ void dm_open_expr(lua_State *L);  /* dm.sym, dm.fn, dm.trace, ... (l_expr.c, l_e
 void dm_open_system(lua_State *L);      /* dm.system (l_system.c, l_system.h) */
 void dm_open_builtin(lua_State *L);     /* dm.builtin.*, dm.systems catalog (l_builtin.c) */
 void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.order_estimate, dm.methods */
-void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c); wraps dm.integrator for reductions */
+void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
+/* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
+ * bindings whose objects make integrators (red:integrator). */
+int dm_lua_integrator(lua_State *L);
 
 /* ---- module opener ------------------------------------------------------------ */
 

@@ -33,6 +33,11 @@ typedef struct dm_lstate {
   double *q, *p, *v;         /* n each (into dm_linteg.buf or caller memory) */
 } dm_lstate;
 
+/* The System at idx, or the one an object at idx stands for: its
+ * metatable's __system (a function of the object) returns it, e.g. a
+ * Routh reduction's reduced system; replaced at idx.  Raises "system
+ * expected". */
+dm_lsystem *dm_linteg_checksystem(lua_State *L, int idx);
 /* The open Integrator at idx, rebuilt first if its system's parameters
  * changed since it was built; raises otherwise. */
 dm_linteg *dm_linteg_check(lua_State *L, int idx);
@@ -57,10 +62,12 @@ void dm_linteg_pushstate(lua_State *L, const dm_linteg *li, double t, const doub
  * (NAN when absent) and, for method "prk", the user tableau: pushes one
  * value, a userdata owning that tableau (or nil), so nothing leaks when a
  * later check raises; opt->tableau points into it.  Options are mapped by
- * name through dm_integ_options; each must apply to the method.  Raises
- * naming `fname`. */
+ * name through dm_integ_options; each must apply to the method, which must
+ * apply to sys (its kind picks the family).  Raises naming `fname`. */
 void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const *skip,
-                     dm_integ_opts *opt, const char **method, double *h);
+                     const dm_system *sys, dm_integ_opts *opt, const char **method, double *h);
+/* "a, b, gsl:<stepper>": the methods for systems of this kind (pushed). */
+void dm_linteg_push_methods(lua_State *L, const char *kind);
 
 /* The tableau box class (l_integ_opts.c). */
 void dm_linteg_open_opts(lua_State *L);

@@ -92,14 +92,28 @@ static int l_tableau(lua_State *L)
   return 1;
 }
 
-/* dm.methods() -> {name = summary, ...} */
+/* dm.methods([sys | kind]) -> {name = summary, ...}: the families for that
+ * kind of system (default: Lagrangian), under each name they answer to */
 static int l_methods(lua_State *L)
 {
-  const dm_integrator_type *const *t = dm_integrator_types();
+  const char *kind = NULL;
+  size_t i, count = dm_integrator_count();
+  if (lua_type(L, 1) == LUA_TSTRING)
+    kind = lua_tostring(L, 1);
+  else if (!lua_isnoneornil(L, 1))
+    kind = dm_linteg_checksystem(L, 1)->sys.kind;
   lua_newtable(L);
-  for (; *t != NULL; t++) {
-    lua_pushstring(L, (*t)->summary);
-    lua_setfield(L, -2, strcmp((*t)->name, "gsl") == 0 ? "gsl:<stepper>" : (*t)->name);
+  for (i = 0; i < count; i++) {
+    const dm_integrator_type *t = dm_integrator_type_at(i);
+    const char *const *a;
+    if (!dm_integrator_accepts(t, kind))
+      continue;
+    lua_pushstring(L, t->summary);
+    lua_setfield(L, -2, strcmp(t->name, "gsl") == 0 ? "gsl:<stepper>" : t->name);
+    for (a = t->names; a != NULL && *a != NULL; a++) {
+      lua_pushstring(L, t->summary);
+      lua_setfield(L, -2, *a);
+    }
   }
   return 1;
 }
@@ -123,7 +137,7 @@ static int l_order_estimate(lua_State *L)
     return luaL_error(L, "dm.order_estimate: field 'system' must be a system, got %s",
                       luaL_typename(L, 2));
   n = ls->n;
-  dm_linteg_parse(L, 1, "dm.order_estimate", skip, &opt, &method, &hopt);  /* 3: box */
+  dm_linteg_parse(L, 1, "dm.order_estimate", skip, &ls->sys, &opt, &method, &hopt);  /* 3 */
   T = dm_optnumberfield(L, 1, "t", NAN);
   if (!isfinite(T) || T == 0.0)
     return luaL_error(L, "dm.order_estimate: field 't' (the final time, != 0) is required");
@@ -159,8 +173,9 @@ const dm_reg dm_linteg_diag_funcs[] = {
    "dm.tableau(\"gauss\" | \"lobatto\", s) | dm.tableau(\"galerkin\", {c...}) | "
    "dm.tableau(\"midpoint\" | \"trapezoid\") -> {name, s, order, c, b, bt, a, at, symplectic, symmetric, defect}",
    "The partitioned Runge-Kutta coefficients of a Galerkin method (usable as tableau= of method \"prk\")."},
-  {"methods", l_methods, "dm.methods() -> {name = summary, ...}",
-   "The integration methods dm.integrator knows, with one line each."},
+  {"methods", l_methods, "dm.methods([sys | kind]) -> {name = summary, ...}",
+   "The integration methods dm.integrator knows for a kind of system (default: Lagrangian "
+   "systems; a system, a Routh reduction, or a kind such as \"routh\"), with one line each."},
   {"order_estimate", l_order_estimate,
    "dm.order_estimate{system=, method=, stages=, ..., state=, t=, h={h1, h2, ...}[, reference=state]} -> order, errors",
    "Integrate to time t with each step size and fit the slope of log(error) against log(h); "

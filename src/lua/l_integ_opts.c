@@ -138,17 +138,26 @@ static dm_tableau *parse_tableau(lua_State *L, int idx, const char *fname)
   return t;
 }
 
-static void known_methods(lua_State *L)
+/* "a, b, gsl:<stepper>": the methods for systems of this kind (pushed) */
+void dm_linteg_push_methods(lua_State *L, const char *kind)
 {
-  const dm_integrator_type *const *t = dm_integrator_types();
+  size_t i, k = 0, count = dm_integrator_count();
   luaL_Buffer b;
   luaL_buffinit(L, &b);
-  for (; *t != NULL; t++) {
-    luaL_addstring(&b, (*t)->name);
-    if (strcmp((*t)->name, "gsl") == 0)
-      luaL_addstring(&b, ":<stepper>");
-    if (t[1] != NULL)
+  for (i = 0; i < count; i++) {
+    const dm_integrator_type *t = dm_integrator_type_at(i);
+    const char *const *a;
+    if (!dm_integrator_accepts(t, kind))
+      continue;
+    if (k++)
       luaL_addstring(&b, ", ");
+    luaL_addstring(&b, t->name);
+    if (strcmp(t->name, "gsl") == 0)
+      luaL_addstring(&b, ":<stepper>");
+    for (a = t->names; a != NULL && *a != NULL; a++) {
+      luaL_addstring(&b, ", ");
+      luaL_addstring(&b, *a);
+    }
   }
   luaL_pushresult(&b);
 }
@@ -204,9 +213,10 @@ static void set_option(lua_State *L, const dm_option_desc *d, const char *fname,
 }
 
 void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const *skip,
-                     dm_integ_opts *opt, const char **method, double *h)
+                     const dm_system *sys, dm_integ_opts *opt, const char **method, double *h)
 {
   const dm_integrator_type *type;
+  dm_err e;
   idx = lua_absindex(L, idx);
   dm_integ_opts_init(opt);
   *method = "gauss";
@@ -217,10 +227,8 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
     *method = lua_tostring(L, -1);
   }
   lua_pop(L, 1);
-  if ((type = dm_integrator_lookup(*method, NULL)) == NULL) {
-    known_methods(L);
-    luaL_error(L, "%s: unknown method '%s' (known: %s)", fname, *method, lua_tostring(L, -1));
-  }
+  if ((type = dm_integrator_select(sys, *method, NULL, &e)) == NULL)
+    luaL_error(L, "%s: %s", fname, e.msg);
   lua_pushnil(L);
   while (lua_next(L, idx) != 0) {
     const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;

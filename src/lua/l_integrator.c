@@ -51,10 +51,29 @@ dm_linteg *dm_linteg_check(lua_State *L, int idx)
   return li;
 }
 
-/* dm.integrator(sys, {method=, h=, ...}) */
-static int l_integrator(lua_State *L)
+dm_lsystem *dm_linteg_checksystem(lua_State *L, int idx)
 {
-  dm_lsystem *ls = dm_lua_checksystem(L, 1);
+  dm_lsystem *ls = dm_lua_tosystem(L, idx);
+  if (ls != NULL)
+    return ls;
+  idx = lua_absindex(L, idx);
+  if (luaL_getmetafield(L, idx, "__system") != LUA_TNIL) {
+    lua_pushvalue(L, idx);
+    lua_call(L, 1, 1);
+    if ((ls = dm_lua_tosystem(L, -1)) != NULL) {
+      lua_replace(L, idx);
+      return ls;
+    }
+    lua_pop(L, 1);
+  }
+  dm_argexpected(L, idx, "system", luaL_typename(L, idx));
+  return NULL;
+}
+
+/* dm.integrator(sys, {method=, h=, ...}) */
+int dm_lua_integrator(lua_State *L)
+{
+  dm_lsystem *ls = dm_linteg_checksystem(L, 1);
   const char *method;
   double h;
   if (lua_isnoneornil(L, 2)) {
@@ -69,7 +88,7 @@ static int l_integrator(lua_State *L)
   lua_pushvalue(L, 1);
   lua_setiuservalue(L, 3, 1);
   li->ls = ls;
-  dm_linteg_parse(L, 2, "dm.integrator", NULL, &li->opt, &method, &h);   /* 4: box */
+  dm_linteg_parse(L, 2, "dm.integrator", NULL, &ls->sys, &li->opt, &method, &h);  /* 4: box */
   lua_setiuservalue(L, 3, 2);
   if (strlen(method) >= sizeof li->method)
     return luaL_error(L, "dm.integrator: method name too long");
@@ -108,7 +127,7 @@ static void check_finite(lua_State *L, const double *x, size_t n, const char *fn
   char num[32];
   for (size_t i = 0; i < n; i++)
     if (!isfinite(x[i])) {
-      dm_fmtnum(num, sizeof num, fabs(x[i]));
+      dm_num_format(num, sizeof num, fabs(x[i]));
       luaL_error(L, "%s: state.%s contains NaN or Inf (component %d = %s)", fname, what,
                  (int)i + 1, num);
     }
@@ -374,23 +393,6 @@ static int i_reset(lua_State *L)
  * fields and metamethods
  * ======================================================================= */
 
-/* The number of stages actually used (0 when the notion does not apply). */
-static int actual_stages(const dm_linteg *li)
-{
-  const char *m = li->I->type->name;
-  if (strcmp(m, "midpoint") == 0)
-    return 1;
-  if (strcmp(m, "trapezoid") == 0)
-    return 2;
-  if (strcmp(m, "prk") == 0 && li->opt.tableau)
-    return (int)li->opt.tableau->s;
-  if (strcmp(m, "gauss") == 0)
-    return li->opt.stages ? li->opt.stages : li->I->order / 2;
-  if (strcmp(m, "lobatto") == 0)
-    return li->opt.stages ? li->opt.stages : li->I->order / 2 + 1;
-  return 0;
-}
-
 static void push_stats(lua_State *L, const dm_integ_stats *s)
 {
   lua_createtable(L, 0, 6);
@@ -436,10 +438,11 @@ static int integ_index(lua_State *L)
       lua_pushnumber(L, li->h);
   } else if (strcmp(k, "method") == 0) {
     lua_pushstring(L, li->method);
+  } else if (strcmp(k, "family") == 0) {
+    lua_pushstring(L, li->I->type->name);
   } else if (strcmp(k, "stages") == 0) {
-    int s = actual_stages(li);
-    if (s > 0)
-      lua_pushinteger(L, s);
+    if (li->I->stages > 0)
+      lua_pushinteger(L, li->I->stages);
     else
       lua_pushnil(L);
   } else if (strcmp(k, "order") == 0) {
@@ -451,7 +454,7 @@ static int integ_index(lua_State *L)
   } else if (strcmp(k, "summary") == 0) {
     lua_pushstring(L, li->I->type->summary);
   } else if (!flag_field(L, li, k)) {
-    return luaL_error(L, "integrator has no field or method '%s' (fields: h, method, stages, "
+    return luaL_error(L, "integrator has no field or method '%s' (fields: h, method, family, stages, "
                       "order, system, stats, summary, symplectic, symmetric, explicit, "
                       "variational, exact_jacobian)", k);
   }
@@ -478,8 +481,7 @@ static int integ_tostring(lua_State *L)
 {
   dm_linteg *li = luaL_checkudata(L, 1, DM_INTEG_MT);
   luaL_Buffer b;
-  char num[32];
-  int s;
+  char num[DM_NUM_BUFSIZE];
   if (li->I == NULL) {
     lua_pushliteral(L, "<integrator (closed)>");
     return 1;
@@ -487,9 +489,8 @@ static int integ_tostring(lua_State *L)
   luaL_buffinit(L, &b);
   lua_pushfstring(L, "<integrator %s", li->method);
   luaL_addvalue(&b);
-  if ((s = actual_stages(li)) > 0 && strcmp(li->method, "midpoint") != 0 &&
-      strcmp(li->method, "trapezoid") != 0) {
-    lua_pushfstring(L, " s=%d", s);
+  if (dm_integrator_stages_chosen(li->I)) {
+    lua_pushfstring(L, " s=%d", li->I->stages);
     luaL_addvalue(&b);
   }
   if (li->I->order > 0) {
@@ -497,7 +498,7 @@ static int integ_tostring(lua_State *L)
     luaL_addvalue(&b);
   }
   if (!isnan(li->h)) {
-    dm_fmtnum(num, sizeof num, li->h);
+    dm_num_format(num, sizeof num, li->h);
     luaL_addstring(&b, " h=");
     luaL_addstring(&b, num);
   }
@@ -551,12 +552,16 @@ static const dm_reg integ_methods[] = {
 };
 
 static const dm_reg integ_funcs[] = {
-  {"integrator", l_integrator,
-   "dm.integrator(sys, {method=\"gauss\", stages=, h=, tol=, maxiter=, simplified=, order=, "
+  {"integrator", dm_lua_integrator,
+   "dm.integrator(sys | red, {method=\"gauss\", stages=, h=, tol=, maxiter=, simplified=, order=, "
    "scheme=, base=, explicit=, tableau=, adaptive=, epsabs=, epsrel=}) -> integ",
-   "A one-step integrator for a system; methods midpoint, gauss, trapezoid (Stormer-Verlet), "
-   "lobatto, prk (tableau={a=, b=[, at=, bt=, c=]}, symplecticity checked), composition, rk4 "
-   "and gsl:<stepper>; an option that does not apply to the method is an error."},
+   "A one-step integrator for a system; the system's kind picks the method families "
+   "(dm.methods(sys) lists them).  Lagrangian systems: midpoint, gauss, trapezoid "
+   "(Stormer-Verlet), lobatto, prk (tableau={a=, b=[, at=, bt=, c=]}, symplecticity checked), "
+   "composition, rk4 and gsl:<stepper>.  A Routh reduction (dm.routh) or its reduced system: "
+   "gauss | midpoint | lobatto | trapezoid | prk (RSPRK), dr[:gauss | :lobatto] (discrete Routh "
+   "equations), classical[:<method>] (SPRK of the classical Routhian with the momentum shift).  "
+   "An option that does not apply to the method is an error."},
   {NULL, NULL, NULL, NULL}
 };
 

@@ -245,7 +245,7 @@ static int gp_fmt(lua_State *L)
 {
   char buf[64];
   double x = luaL_checknumber(L, 1);
-  dm_fmtnum(buf, sizeof buf, x);
+  dm_num_format(buf, sizeof buf, x);
   lua_pushstring(L, buf);
   return 1;
 }

@@ -9,11 +9,10 @@
  * A Routh reduction is a userdata "dmech.routh" holding the dm_routh, whose
  * owner is the reduced System userdata (user value 1; its free_data frees
  * the dm_routh, so integrators, which anchor their System, keep it alive);
- * user value 2 is the original System.  dm.integrator is wrapped (after the
- * integrator binding has registered it) so that a reduction or its reduced
- * System gets the "routh" family: method "gauss" becomes "routh:gauss"
- * (RSPRK), "dr" the discrete Routh equations, "classical" the SPRK of the
- * classical Routhian.  Formulas are expression userdata; the connection,
+ * user value 2 is the original System.  The metatable's __system gives
+ * dm.integrator the reduced System, whose kind ("routh") selects the
+ * reduced integrator families: "gauss" is RSPRK, "dr" the discrete Routh
+ * equations, "classical" the SPRK of the classical Routhian.  Formulas are expression userdata; the connection,
  * the magnetic 2-form and matrices are Lua tables of expressions whose
  * tostring shows the form (e.g. "(m2*...)*dr1 + ...").  No numerics here. */
 #include <config.h>
@@ -368,7 +367,7 @@ void dm_lrouth_push_numbers(lua_State *L, const double *x, size_t n)
 /* }====================================================================== */
 
 /* {======================================================================
- * fields, printing, the dm.integrator dispatch, opener
+ * fields, printing, the System dm.integrator integrates, opener
  * ======================================================================= */
 
 static const char *const fields =
@@ -497,7 +496,7 @@ static int r_tostring(lua_State *L)
     luaL_addstring(&b, i ? ", " : "; ");
     luaL_addstring(&b, rs->params[x->npar + i]);
     luaL_addstring(&b, "=");
-    dm_fmtnum(num, sizeof num, dm_routh_mu(u->red)[i]);
+    dm_num_format(num, sizeof num, dm_routh_mu(u->red)[i]);
     luaL_addstring(&b, num);
   }
   if (!dm_routh_is_mechanical(u->red)) {
@@ -520,39 +519,13 @@ static int r_tostring(lua_State *L)
   return 1;
 }
 
-/* is_reduction(x): 1 for a Routh reduction, raises for its reduced System
- * given alone (core methods would drop the magnetic term), else false */
-static int is_reduction(lua_State *L)
+/* __system: the reduced System that dm.integrator(red, ...) integrates */
+static int r_system(lua_State *L)
 {
-  dm_lsystem *ls;
-  if (luaL_testudata(L, 1, DM_ROUTH_MT) != NULL) {
-    dm_lrouth_check(L, 1);
-    lua_pushboolean(L, 1);
-    return 1;
-  }
-  ls = dm_lua_tosystem(L, 1);
-  if (ls != NULL && dm_routh_of_system(&ls->sys, NULL))
-    luaL_argerror(L, 1, "give the Routh reduction (dm.routh) rather than its reduced system");
-  lua_pushboolean(L, 0);
+  dm_lrouth_check(L, 1);
+  lua_getiuservalue(L, 1, 1);
   return 1;
 }
-
-static int reduced_integrator(lua_State *L)
-{
-  dm_lrouth_integrator(L, 1, lua_isnoneornil(L, 2) ? 0 : 2);
-  return 1;
-}
-
-/* dm.integrator(red | sys, opts): written in Lua so that the integrator
- * binding's own function is called (not tail-called) through a local named
- * `integrator`, keeping its argument errors' function name */
-static const char dispatch_src[] =
-  "local integrator, is_reduction, reduced_integrator = ...\n"
-  "return function(sys, opts, ...)\n"
-  "  if is_reduction(sys) then return reduced_integrator(sys, opts) end\n"
-  "  local a, b = integrator(sys, opts, ...)\n"
-  "  return a, b\n"
-  "end\n";
 
 static const dm_reg routh_funcs[] = {
   {"routh", l_routh, "dm.routh(sys, {cyclic = {\"theta\", ...}[, mu = number | {...}][, native = mode]}) -> routh",
@@ -592,8 +565,12 @@ static const struct { const char *name, *doc; } field_docs[] = {
 
 void dm_open_reduce(lua_State *L)
 {
-  static const luaL_Reg meta[] = {{"__tostring", r_tostring}, {NULL, NULL}};
+  static const luaL_Reg meta[] = {{"__tostring", r_tostring}, {"__system", r_system},
+                                  {NULL, NULL}};
   size_t i;
+  dm_err e;
+  if (dm_routh_register_integrators(&e) != DM_OK)
+    luaL_error(L, "dm.routh: %s", e.msg);
   dm_lrouth_open_boxes(L);
   dm_newclass(L, DM_ROUTH_MT, "routh", dm_lrouth_methods, meta);
   lua_getfield(L, -1, "__methods");
@@ -603,38 +580,4 @@ void dm_open_reduce(lua_State *L)
   dm_register(L, "dm.", routh_funcs);
   for (i = 0; field_docs[i].name; i++)
     dm_doc_add(L, field_docs[i].name, field_docs[i].name, field_docs[i].doc, 0);
-  /* wrap dm.integrator: reductions get the "routh" family */
-  {
-    int dmt = lua_gettop(L), c;
-    const char *sig = "dm.integrator(sys | red, {method=, h=, ...}) -> integrator";
-    const char *doc = "An integrator for a system or a Routh reduction.";
-    if (lua_getfield(L, dmt, "integrator") == LUA_TFUNCTION) {
-      lua_pushvalue(L, -1);
-      lua_setfield(L, LUA_REGISTRYINDEX, DM_ROUTH_ORIG_INTEGRATOR);
-      if (luaL_loadbuffer(L, dispatch_src, sizeof dispatch_src - 1, "=dm.integrator") != LUA_OK)
-        lua_error(L);
-      lua_insert(L, -2);
-      lua_pushcfunction(L, is_reduction);
-      lua_pushcfunction(L, reduced_integrator);
-      lua_call(L, 3, 1);
-      c = lua_gettop(L);
-      dm_pushdocs(L);
-      if (lua_getfield(L, -1, "dm.integrator") == LUA_TTABLE) {
-        lua_getfield(L, -1, "sig");
-        lua_getfield(L, -2, "doc");
-        lua_pushfstring(L, "%s For a Routh reduction (dm.routh) the methods are the reduced ones: "
-                        "gauss | midpoint | lobatto | trapezoid | prk (RSPRK), dr[:gauss | :lobatto] "
-                        "(discrete Routh equations), classical[:<method>] (SPRK of the classical "
-                        "Routhian with the momentum shift).",
-                        lua_tostring(L, -1) ? lua_tostring(L, -1) : "");
-        if (lua_tostring(L, -3))
-          sig = lua_tostring(L, -3);
-        doc = lua_tostring(L, -1);
-      }
-      dm_doc_add(L, "dm.integrator", sig, doc, c);
-      lua_pushvalue(L, c);
-      lua_setfield(L, dmt, "integrator");
-    }
-    lua_settop(L, dmt);
-  }
 }

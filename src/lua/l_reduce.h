@@ -1,5 +1,5 @@
 /* l_reduce.h -- private glue of the Routh reduction binding: l_reduce.c
- * (dm.routh, fields, formulas, the dm.integrator dispatch) and
+ * (dm.routh, fields, formulas) and
  * l_reduce_ops.c (methods: set_mu, project, lift, reconstruct, phase, eval,
  * psi, defect, integrator).  Not for other bindings.
  *
@@ -16,8 +16,6 @@
 #include "core/trajectory.h"
 
 #define DM_ROUTH_MT "dmech.routh"
-/* registry key of the integrator binding's own dm.integrator */
-#define DM_ROUTH_ORIG_INTEGRATOR "dmech.routh.integrator"
 
 typedef struct dm_lrouth {
   dm_routh *red;          /* owned by the reduced System (user value 1) */

@@ -46,7 +46,7 @@ static int ibox_gc(lua_State *L)
   return 0;
 }
 
-/* method = "routh:<opts.method or def>", stages, h from the table at opts
+/* method = opts.method or def, stages, h from the table at opts
  * (0: none); pushes the box; *h gets opts.h or NAN */
 static dm_integrator *boxed_integrator(lua_State *L, dm_routh *red, int opts, const char *def,
                                        int def_stages, double *h, const char *fname)
@@ -67,8 +67,6 @@ static dm_integrator *boxed_integrator(lua_State *L, dm_routh *red, int opts, co
     else if (!lua_isnil(L, -1))
       luaL_error(L, "%s: option 'method' must be a string", fname);
     lua_pop(L, 1);
-    if (strncmp(method, "routh:", 6) == 0)
-      method += 6;
     if (lua_getfield(L, opts, "stages") != LUA_TNIL)
       o.stages = (int)luaL_checkinteger(L, -1);
     lua_pop(L, 1);
@@ -421,34 +419,15 @@ static int m_defect(lua_State *L)
 
 void dm_lrouth_integrator(lua_State *L, int idx, int opts)
 {
-  const char *method = "gauss";
   idx = lua_absindex(L, idx);
   if (opts)
     opts = lua_absindex(L, opts);
-  if (lua_getfield(L, LUA_REGISTRYINDEX, DM_ROUTH_ORIG_INTEGRATOR) != LUA_TFUNCTION)
-    luaL_error(L, "the integrator binding is not loaded");
-  lua_getiuservalue(L, idx, 1);                                /* the reduced System */
-  lua_newtable(L);
-  if (opts) {
-    luaL_checktype(L, opts, LUA_TTABLE);
-    lua_pushnil(L);
-    while (lua_next(L, opts) != 0) {
-      lua_pushvalue(L, -2);
-      lua_insert(L, -2);
-      lua_settable(L, -4);
-    }
-    if (lua_getfield(L, opts, "method") != LUA_TNIL) {
-      if (lua_type(L, -1) != LUA_TSTRING)
-        luaL_error(L, "dm.integrator: option 'method' must be a string, got %s", luaL_typename(L, -1));
-      method = lua_tostring(L, -1);
-    }
-    lua_pop(L, 1);
-  }
-  if (strncmp(method, "routh:", 6) == 0)
-    lua_pushstring(L, method);
+  lua_pushcfunction(L, dm_lua_integrator);
+  lua_pushvalue(L, idx);
+  if (opts)
+    lua_pushvalue(L, opts);
   else
-    lua_pushfstring(L, "routh:%s", method);
-  lua_setfield(L, -2, "method");
+    lua_pushnil(L);
   lua_call(L, 2, 1);
 }
 

@@ -314,7 +314,7 @@ static int system_tostring(lua_State *L)
     luaL_addstring(&b, i == 0 ? ", " : " ");
     luaL_addstring(&b, ls->sys.params[i]);
     luaL_addchar(&b, '=');
-    dm_fmtnum(num, sizeof num, ls->sys.par[i]);
+    dm_num_format(num, sizeof num, ls->sys.par[i]);
     luaL_addstring(&b, num);
   }
   if (ls->m) {
@@ -400,7 +400,7 @@ static int params_tostring(lua_State *L)
     luaL_addstring(&b, i ? ", " : "");
     luaL_addstring(&b, ls->sys.params[i]);
     luaL_addstring(&b, " = ");
-    dm_fmtnum(num, sizeof num, ls->sys.par[i]);
+    dm_num_format(num, sizeof num, ls->sys.par[i]);
     luaL_addstring(&b, num);
   }
   luaL_addchar(&b, '}');

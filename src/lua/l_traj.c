@@ -274,8 +274,8 @@ static int t_tostring(lua_State *L)
   lua_pushfstring(L, "<Trajectory %I sample%s", (lua_Integer)len, len == 1 ? "" : "s");
   luaL_addvalue(&b);
   if (len > 0) {
-    dm_fmtnum(a, sizeof a, dm_traj_col(tr, 0)[0]);
-    dm_fmtnum(z, sizeof z, dm_traj_col(tr, 0)[len - 1]);
+    dm_num_format(a, sizeof a, dm_traj_col(tr, 0)[0]);
+    dm_num_format(z, sizeof z, dm_traj_col(tr, 0)[len - 1]);
     lua_pushfstring(L, " t=[%s,%s]", a, z);
     luaL_addvalue(&b);
   }
@@ -359,28 +359,32 @@ static int t_meta(lua_State *L)
   if (lua_isnoneornil(L, 2)) {
     lua_createtable(L, 0, (int)dm_traj_meta_count(tr));
     for (i = 0; i < dm_traj_meta_count(tr); i++) {
-      const char *k, *v;
-      dm_traj_meta_at(tr, i, &k, &v);
-      lua_pushstring(L, v);
+      const char *k;
+      dm_traj_meta_at(tr, i, &k, NULL);
+      dm_ltraj_pushmeta(L, tr, i);
       lua_setfield(L, -2, k);
     }
     return 1;
   }
   if (lua_gettop(L) >= 3) {
     const char *key = luaL_checkstring(L, 2);
-    const char *val = lua_isnil(L, 3) ? NULL : dm_ltraj_metavalue(L, 3);
     dm_err e;
-    if (dm_traj_meta_set(tr, key, val, &e) != DM_OK)
+    if (dm_ltraj_setmeta(L, tr, key, 3, &e) != DM_OK)
       return luaL_argerror(L, 2, e.msg);
     lua_settop(L, 1);
     return 1;
   }
   {
-    const char *v = dm_traj_meta_get(tr, luaL_checkstring(L, 2));
-    if (v == NULL)
-      lua_pushnil(L);
-    else
-      lua_pushstring(L, v);
+    const char *key = luaL_checkstring(L, 2);
+    for (i = 0; i < dm_traj_meta_count(tr); i++) {
+      const char *k;
+      dm_traj_meta_at(tr, i, &k, NULL);
+      if (strcmp(k, key) == 0) {
+        dm_ltraj_pushmeta(L, tr, i);
+        return 1;
+      }
+    }
+    lua_pushnil(L);
   }
   return 1;
 }
@@ -546,7 +550,7 @@ static int t_derive(lua_State *L)
   u->busy = 0;
   if (c.failed) {
     char tbuf[32];
-    dm_fmtnum(tbuf, sizeof tbuf, c.t);
+    dm_num_format(tbuf, sizeof tbuf, c.t);
     if (lua_type(L, -1) == LUA_TSTRING)
       return luaL_error(L, "derive '%s': at sample %I (t = %s): %s", names[0],
                         (lua_Integer)c.k + 1, tbuf, lua_tostring(L, -1));

@@ -5,11 +5,14 @@
 #define DM_L_TRAJ_H
 
 #include "lua/dmlua.h"
+#include "core/trajectory.h"
 
-/* The metadata value at arg as a string pushed on the stack: strings as they
- * are, floats in shortest round-trip form, integers and booleans by
- * tostring; anything else raises "string or number expected". */
-const char *dm_ltraj_metavalue(lua_State *L, int arg);
+/* Set metadata key of tr to the value at arg: numbers as numbers, strings
+ * and booleans as strings (tostring), nil removes; anything else raises
+ * "string or number expected".  Returns the trajectory's status. */
+int dm_ltraj_setmeta(lua_State *L, dm_traj *tr, const char *key, int arg, dm_err *e);
+/* Push the value of metadata item i: a number or a string. */
+void dm_ltraj_pushmeta(lua_State *L, const dm_traj *tr, size_t i);
 
 /* Put dm.trajectory into the table at the top of the stack. */
 void dm_ltraj_open_build(lua_State *L);

@@ -3,6 +3,7 @@
  * converted into a vec anchored on the Lua stack before the trajectory is
  * filled, so an error at any point leaks nothing. */
 #include <config.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -10,19 +11,34 @@
 #include "lua/l_traj.h"
 #include "core/trajectory.h"
 
-/* A metadata value from Lua: strings as they are, numbers round-tripping. */
-const char *dm_ltraj_metavalue(lua_State *L, int arg)
+int dm_ltraj_setmeta(lua_State *L, dm_traj *tr, const char *key, int arg, dm_err *e)
 {
-  if (lua_type(L, arg) == LUA_TNUMBER && !lua_isinteger(L, arg)) {
-    char buf[32];
-    dm_fmtnum(buf, sizeof buf, lua_tonumber(L, arg));
-    return lua_pushstring(L, buf);
+  int t = lua_type(L, arg);
+  if (t == LUA_TNIL)
+    return dm_traj_meta_set(tr, key, NULL, e);
+  if (t == LUA_TNUMBER)
+    return dm_traj_meta_set_number(tr, key, lua_tonumber(L, arg), e);
+  if (t == LUA_TSTRING || t == LUA_TBOOLEAN) {
+    int st = dm_traj_meta_set(tr, key, luaL_tolstring(L, arg, NULL), e);
+    lua_pop(L, 1);
+    return st;
   }
-  if (lua_type(L, arg) == LUA_TNUMBER || lua_type(L, arg) == LUA_TSTRING
-      || lua_type(L, arg) == LUA_TBOOLEAN)
-    return luaL_tolstring(L, arg, NULL);
-  dm_argexpected(L, arg, "string or number", luaL_typename(L, arg));
-  return NULL;
+  return dm_argexpected(L, arg, "string or number", luaL_typename(L, arg));
+}
+
+void dm_ltraj_pushmeta(lua_State *L, const dm_traj *tr, size_t i)
+{
+  const char *v;
+  double x;
+  if (dm_traj_meta_number_at(tr, i, &x)) {
+    if (x == floor(x) && fabs(x) < 0x1p53)
+      lua_pushinteger(L, (lua_Integer)x);
+    else
+      lua_pushnumber(L, x);
+  } else {
+    dm_traj_meta_at(tr, i, NULL, &v);
+    lua_pushstring(L, v);
+  }
 }
 
 /* {======================================================================
@@ -235,13 +251,11 @@ static int l_trajectory(lua_State *L)
     keys = sorted_keys(L, midx, &nm, "meta");
     top = lua_gettop(L);
     for (i = 0; i < nm; i++) {
-      const char *val;
       lua_getfield(L, midx, keys[i]);
       if (lua_type(L, -1) != LUA_TSTRING && lua_type(L, -1) != LUA_TNUMBER)
         return luaL_error(L, "bad argument #1 to 'trajectory' (field 'meta.%s': string "
                           "or number expected, got %s)", keys[i], luaL_typename(L, -1));
-      val = dm_ltraj_metavalue(L, lua_gettop(L));
-      if (dm_traj_meta_set(tr, keys[i], val, &e) != DM_OK)
+      if (dm_ltraj_setmeta(L, tr, keys[i], lua_gettop(L), &e) != DM_OK)
         return luaL_error(L, "bad argument #1 to 'trajectory' (field 'meta': %s)", e.msg);
       lua_settop(L, top);
     }

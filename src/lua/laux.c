@@ -76,22 +76,3 @@ const char *dm_optstringfield(lua_State *L, int t, const char *key,
   return s;
 }
 
-int dm_fmtnum(char *buf, size_t size, double x)
-{
-  int prec, len = 0;
-  char *p;
-  if (x != x)
-    return snprintf(buf, size, "nan");
-  if (x == HUGE_VAL || x == -HUGE_VAL)
-    return snprintf(buf, size, x > 0 ? "inf" : "-inf");
-  for (prec = 15; prec <= 17; prec++) {
-    len = snprintf(buf, size, "%.*g", prec, x);
-    if (strtod(buf, NULL) == x)
-      break;
-  }
-  /* Programs that set LC_NUMERIC could give a decimal comma: undo it. */
-  for (p = buf; *p != '\0'; p++)
-    if (*p == ',')
-      *p = '.';
-  return len;
-}

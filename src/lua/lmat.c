@@ -509,7 +509,7 @@ static int mm_tostring(lua_State *L)
   int w = 1;
   for (i = 0; i < m->size1; i++)
     for (j = 0; j < m->size2; j++) {
-      int len = dm_fmtnum(num, sizeof num, gsl_matrix_get(m, i, j));
+      int len = dm_num_format(num, sizeof num, gsl_matrix_get(m, i, j));
       if (len > w)
         w = len;
     }
@@ -519,7 +519,7 @@ static int mm_tostring(lua_State *L)
     luaL_addstring(&b, i == 0 ? "{" : ",\n    {");
     for (j = 0; j < m->size2; j++) {
       char cell[48];
-      dm_fmtnum(num, sizeof num, gsl_matrix_get(m, i, j));
+      dm_num_format(num, sizeof num, gsl_matrix_get(m, i, j));
       snprintf(cell, sizeof cell, "%s%*s", j > 0 ? ", " : "", w, num);
       luaL_addstring(&b, cell);
     }

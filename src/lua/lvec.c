@@ -426,7 +426,7 @@ static int m_tostring(lua_State *L)
   for (i = 0; i < n; i++) {
     if (i > 0)
       luaL_addstring(&b, ", ");
-    dm_fmtnum(num, sizeof num, gsl_vector_get(v, i));
+    dm_num_format(num, sizeof num, gsl_vector_get(v, i));
     luaL_addstring(&b, num);
   }
   if (n < v->size) {

@@ -26,9 +26,10 @@
  *
  * Systems.  dm_routh_system() is the reduced system on the shape (or
  * preshape) space: Lagrangian R^mu, params = original params then mu,
- * reduced force and constraints.  It is meant for the "routh" integrator
- * family (dm_routh_integrator_new): a core method applied to it directly
- * integrates R^mu WITHOUT the magnetic term (right only when B = 0).
+ * reduced force and constraints; its kind is DM_ROUTH_KIND, so integrators
+ * made for it (dm_integrator_new, dm_routh_integrator_new) are the reduced
+ * families below, never a core method, which would integrate R^mu WITHOUT
+ * the magnetic term.
  * dm_routh_classical() is the plain system of the classical Routhian Rc
  * (canonical momentum y = s + muA); dm_routh_full() the unreduced system.
  *
@@ -215,12 +216,21 @@ int dm_routh_velocity(dm_routh *red, const double *x, const double *s_, double *
 
 /* {==== integrators ====================================================== */
 
-/* Integrator of the "routh" family on red's reduced system (method names
- * above; opts as for dm_integrator_new: stages, tol, maxiter, simplified,
- * tableau for "prk").  Free with dm_integrator_free before red. */
+/* The system kind of reduced systems (dm_system.kind): the integrator
+ * families below answer for it. */
+#define DM_ROUTH_KIND "routh"
+
+/* Register the reduced families (rsprk, dr, classical) with the integrator
+ * registry; idempotent, called by dm_routh_derive and the Lua binding. */
+int dm_routh_register_integrators(dm_err *e);
+
+/* Integrator on red's reduced system (method names above; opts as for
+ * dm_integrator_new: stages, tol, maxiter, simplified, tableau for "prk");
+ * the same as dm_integrator_new(dm_routh_system(red), ...).  Free with
+ * dm_integrator_free before red. */
 int dm_routh_integrator_new(dm_routh *red, const char *method, const dm_integ_opts *opts,
                             dm_integrator **out, dm_err *e);
-/* 1 if I belongs to the "routh" family. */
+/* 1 if I belongs to one of the reduced families. */
 int dm_routh_is_integrator(const dm_integrator *I);
 /* Group coordinate accumulated over the steps taken (r values; starts at 0
  * or at the value set) -- the reconstruction theta_k. */

@@ -576,6 +576,8 @@ int dm_routh_derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, d
   *out = NULL;
   if (ctx == NULL || sp == NULL)
     return dm_err_set(e, DM_EINVAL, "Routh reduction: no context or specification");
+  if ((st = dm_routh_register_integrators(e)) != DM_OK)
+    return st;
   if ((st = check_spec(ctx, sp, e)) != DM_OK)
     return st;
   if ((buf = malloc((sp->n + sp->m + 1) * sizeof *buf)) == NULL)
@@ -584,6 +586,8 @@ int dm_routh_derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, d
   st = hidden_symmetry(ctx, sp, &sp2, buf, e);
   if (st == DM_OK)
     st = derive(ctx, &sp2, out, e);
+  if (st == DM_OK)               /* its integrators are the reduced families */
+    (*out)->sys.kind = DM_ROUTH_KIND;
   free(buf);
   return st;
 }

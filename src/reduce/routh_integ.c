@@ -1,11 +1,11 @@
-/* routh_integ.c -- the "routh" integrator family: one dm_integrator_type
- * (registered in src/integrators/registry.c) whose variant selects the
- * reduced method on the reduced system of a dm_routh (routh.h):
- *   routh:gauss | midpoint | lobatto | trapezoid | prk   RSPRK (rsprk.c)
- *   routh:dr[:midpoint | :gauss | :lobatto]              discrete Routh equations
- *   routh:classical[:gauss | midpoint | lobatto | trapezoid | prk]
- *        the core PRK engine on the classical Routhian Rc, wrapped by the
- *        momentum shift sigma(x, s) = (x, s + muA(x)).
+/* routh_integ.c -- the integrator families of reduced systems (kind
+ * DM_ROUTH_KIND, the reduced system of a dm_routh; routh.h), registered
+ * with the integrator registry by dm_routh_register_integrators:
+ *   rsprk      gauss | midpoint | lobatto | trapezoid | prk: RSPRK (rsprk.c)
+ *   dr         dr[:midpoint | :gauss | :lobatto]: discrete Routh equations
+ *   classical  classical[:gauss | midpoint | lobatto | trapezoid | prk]: the
+ *              core PRK engine on the classical Routhian Rc, wrapped by the
+ *              momentum shift sigma(x, s) = (x, s + muA(x)).
  * State (q, p) = (x, s) for all of them.  The group coordinate is
  * accumulated per step with compensated summation (reconstruction). */
 #include <config.h>
@@ -18,6 +18,7 @@
 #include <string.h>
 
 enum { K_RSPRK, K_DR, K_CLASSICAL };
+static const char *const kind_names[] = {"rsprk", "dr", "classical"};
 
 typedef struct rinteg {
   int kind;
@@ -34,9 +35,11 @@ typedef struct rinteg {
   double sing_ref;
 } rinteg;
 
-extern const dm_integrator_type dm_integ_routh;
+static const dm_integrator_type rsprk_type, dr_type, classical_type;
 
 static const char *const routh_options[] = {"stages", "h", "tol", "maxiter", "simplified", NULL};
+static const char *const routh_kinds[] = {DM_ROUTH_KIND, NULL};
+static const char *const rsprk_names[] = {"gauss", "midpoint", "lobatto", "trapezoid", "prk", NULL};
 
 /* muA(x) with the tape of gyro_r at zero velocity */
 static int muA_at(rinteg *R, const double *x, double *a, dm_err *e)
@@ -124,73 +127,99 @@ static int alloc_classical(dm_integrator *I, rinteg *R, const char *sub, dm_err 
   return st;
 }
 
-static int routh_alloc(dm_integrator *I, dm_err *e)
+/* The state every reduced family starts from. */
+static int rinteg_new(dm_integrator *I, int kind, rinteg **out, dm_err *e)
 {
   rinteg *R;
   dm_routh *red;
-  dm_tableau *t = NULL;
-  char fam[DM_INTEG_STRMAX], *sub;
-  int st;
+  *out = NULL;
   if (!dm_routh_of_system(I->sys, &red))
-    return dm_err_set(e, DM_EINVAL, "method 'routh' needs the reduced system of a Routh reduction "
-                      "(dm_routh_system)");
-  snprintf(fam, sizeof fam, "%s", I->variant[0] ? I->variant : "gauss");
-  sub = strchr(fam, ':');
-  if (sub)
-    *sub++ = '\0';
+    return dm_err_set(e, DM_EINVAL, "method '%s' needs the reduced system of a Routh reduction "
+                      "(dm_routh_system)", I->name);
   if ((R = calloc(1, sizeof *R)) == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
   I->state = R;
+  R->kind = kind;
   R->red = red;
   if (alloc_buffers(R) != DM_OK)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
   I->flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;
-  if (strcmp(fam, "dr") == 0) {
-    const char *s2 = sub ? sub : "midpoint";
-    R->kind = K_DR;
-    if (strcmp(s2, "midpoint") != 0 && (st = make_tableau(s2, &I->opt, &t, e)) != DM_OK)
-      return st;
-    if (strcmp(s2, "prk") == 0 || strcmp(s2, "trapezoid") == 0) {
-      dm_tableau_free(t);
-      return dm_err_set(e, DM_EUNSUP, "dr: discrete Lagrangians are midpoint, gauss or lobatto "
-                        "(Galerkin), got '%s'", s2);
-    }
-    st = dm_routh_dr_alloc(red, t, I->opt.tol, I->opt.maxiter, &R->dr, e);
-    I->order = t ? t->order : 2;
-    dm_tableau_free(t);
-    R->have_theta = 1;
-    I->flags |= DM_INTEG_EXACT_JAC;
-    if (st == DM_OK && t == NULL)
-      I->flags |= DM_INTEG_SYMMETRIC;
+  *out = R;
+  return DM_OK;
+}
+
+/* "gauss", ... or "rsprk[:<tableau family>]" (default gauss) */
+static int rsprk_alloc(dm_integrator *I, dm_err *e)
+{
+  int own = strcmp(I->name, "rsprk") == 0 || strncmp(I->name, "rsprk:", 6) == 0;
+  const char *fam = !own ? I->name : I->variant[0] ? I->variant : "gauss";
+  dm_tableau *t = NULL;
+  rinteg *R;
+  int st;
+  if ((st = rinteg_new(I, K_RSPRK, &R, e)) != DM_OK)
     return st;
-  }
-  if (strcmp(fam, "classical") == 0) {
-    R->kind = K_CLASSICAL;
-    return alloc_classical(I, R, sub ? sub : "gauss", e);
-  }
-  if (red->general && sub == NULL) {
+  if (R->red->general) {
     /* no connection, no RSPRK stage programs: with the momentum shift the
      * identity, RSPRK is the same method on the classical Routhian */
     R->kind = K_CLASSICAL;
-    return alloc_classical(I, R, fam, e);
+    if ((st = alloc_classical(I, R, fam, e)) == DM_OK)
+      I->stages = R->inner->stages;
+    return st;
   }
-  if (sub != NULL)
-    return dm_err_set(e, DM_ENOTFOUND, "unknown reduced method '%s:%s'", fam, sub);
-  R->kind = K_RSPRK;
   if ((st = make_tableau(fam, &I->opt, &t, e)) != DM_OK)
     return st;
-  st = dm_rsprk_alloc(red, t, I->opt.tol, I->opt.maxiter, I->opt.simplified, &R->P, e);
+  st = dm_rsprk_alloc(R->red, t, I->opt.tol, I->opt.maxiter, I->opt.simplified, &R->P, e);
   if (st == DM_OK) {
     I->order = t->order;
+    I->stages = (int)t->s;
     if (t->flags & DM_TAB_SYMMETRIC)
       I->flags |= DM_INTEG_SYMMETRIC;
-    if (red->m == 0)
+    if (R->red->m == 0)
       I->flags |= DM_INTEG_EXACT_JAC;
     if (!(t->flags & DM_TAB_SYMPLECTIC))
       I->flags &= ~(unsigned)DM_INTEG_SYMPLECTIC;
     R->have_theta = 1;
   }
   dm_tableau_free(t);
+  return st;
+}
+
+/* "dr" (= "dr:midpoint"), "dr:gauss", "dr:lobatto" */
+static int dr_alloc(dm_integrator *I, dm_err *e)
+{
+  const char *sub = I->variant[0] ? I->variant : "midpoint";
+  dm_tableau *t = NULL;
+  rinteg *R;
+  int st;
+  if ((st = rinteg_new(I, K_DR, &R, e)) != DM_OK)
+    return st;
+  if (strcmp(sub, "midpoint") != 0 && (st = make_tableau(sub, &I->opt, &t, e)) != DM_OK)
+    return st;
+  if (strcmp(sub, "prk") == 0 || strcmp(sub, "trapezoid") == 0) {
+    dm_tableau_free(t);
+    return dm_err_set(e, DM_EUNSUP, "dr: discrete Lagrangians are midpoint, gauss or lobatto "
+                      "(Galerkin), got '%s'", sub);
+  }
+  st = dm_routh_dr_alloc(R->red, t, I->opt.tol, I->opt.maxiter, &R->dr, e);
+  I->order = t ? t->order : 2;
+  I->stages = t ? (int)t->s : 1;
+  dm_tableau_free(t);
+  R->have_theta = 1;
+  I->flags |= DM_INTEG_EXACT_JAC;
+  if (st == DM_OK && t == NULL)
+    I->flags |= DM_INTEG_SYMMETRIC;
+  return st;
+}
+
+/* "classical" (= "classical:gauss"), "classical:<core method>" */
+static int classical_alloc(dm_integrator *I, dm_err *e)
+{
+  rinteg *R;
+  int st;
+  if ((st = rinteg_new(I, K_CLASSICAL, &R, e)) != DM_OK)
+    return st;
+  if ((st = alloc_classical(I, R, I->variant[0] ? I->variant : "gauss", e)) == DM_OK)
+    I->stages = R->inner->stages;
   return st;
 }
 
@@ -239,30 +268,51 @@ static int classical_step(dm_integrator *I, rinteg *R, double h, const double *x
   return DM_OK;
 }
 
-static int routh_step(dm_integrator *I, double h, const double *q0, const double *p0, double *q1,
+static void zero_dtheta(rinteg *R)
+{
+  size_t a;
+  for (a = 0; a < R->red->r; a++)
+    R->dth[a] = 0.0;
+}
+
+static int classical_type_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                               double *q1, double *p1, dm_err *e);
+
+static int rsprk_step(dm_integrator *I, double h, const double *q0, const double *p0, double *q1,
                       double *p1, dm_err *e)
 {
   rinteg *R = I->state;
   int st;
-  size_t a;
-  for (a = 0; a < R->red->r; a++)
-    R->dth[a] = 0.0;
-  switch (R->kind) {
-  case K_RSPRK:
-    st = dm_rsprk_step(R->P, h, q0, p0, q1, p1, R->dth, &I->stats, e);
-    break;
-  case K_DR:
-    st = dm_routh_dr_step(R->dr, h, q0, p0, q1, p1, R->dth, e);
-    if (st == DM_OK) {
-      I->stats.iters = dm_routh_dr_iters(R->dr);
-      I->stats.iters_total += I->stats.iters;
-      I->stats.steps++;
-    }
-    break;
-  default:
-    st = classical_step(I, R, h, q0, p0, q1, p1, e);
+  if (R->kind == K_CLASSICAL)          /* a general reduction (see rsprk_alloc) */
+    return classical_type_step(I, h, q0, p0, q1, p1, e);
+  zero_dtheta(R);
+  if ((st = dm_rsprk_step(R->P, h, q0, p0, q1, p1, R->dth, &I->stats, e)) == DM_OK)
+    add_theta(R);
+  return st;
+}
+
+static int dr_step(dm_integrator *I, double h, const double *q0, const double *p0, double *q1,
+                   double *p1, dm_err *e)
+{
+  rinteg *R = I->state;
+  int st;
+  zero_dtheta(R);
+  if ((st = dm_routh_dr_step(R->dr, h, q0, p0, q1, p1, R->dth, e)) == DM_OK) {
+    I->stats.iters = dm_routh_dr_iters(R->dr);
+    I->stats.iters_total += I->stats.iters;
+    I->stats.steps++;
+    add_theta(R);
   }
-  if (st == DM_OK)
+  return st;
+}
+
+static int classical_type_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                               double *q1, double *p1, dm_err *e)
+{
+  rinteg *R = I->state;
+  int st;
+  zero_dtheta(R);
+  if ((st = classical_step(I, R, h, q0, p0, q1, p1, e)) == DM_OK)
     add_theta(R);
   return st;
 }
@@ -327,15 +377,26 @@ static int classical_jacobian(dm_integrator *I, rinteg *R, double h, const doubl
   return st;
 }
 
-static int routh_jacobian(dm_integrator *I, double h, const double *q0, const double *p0,
+static int rsprk_jacobian(dm_integrator *I, double h, const double *q0, const double *p0,
                           double *DPhi, dm_err *e)
 {
   rinteg *R = I->state;
-  if (R->kind == K_RSPRK)
-    return dm_rsprk_jacobian(R->P, h, q0, p0, DPhi, &I->stats, e);
   if (R->kind == K_CLASSICAL)
     return classical_jacobian(I, R, h, q0, p0, DPhi, e);
+  return dm_rsprk_jacobian(R->P, h, q0, p0, DPhi, &I->stats, e);
+}
+
+static int dr_jacobian(dm_integrator *I, double h, const double *q0, const double *p0,
+                       double *DPhi, dm_err *e)
+{
+  rinteg *R = I->state;
   return dm_routh_dr_jacobian(R->dr, h, q0, p0, DPhi, e);
+}
+
+static int classical_type_jacobian(dm_integrator *I, double h, const double *q0,
+                                   const double *p0, double *DPhi, dm_err *e)
+{
+  return classical_jacobian(I, I->state, h, q0, p0, DPhi, e);
 }
 
 static void routh_reset(dm_integrator *I)
@@ -349,36 +410,81 @@ static void routh_reset(dm_integrator *I)
   R->sing_ref = 0.0;
 }
 
-const dm_integrator_type dm_integ_routh = {
-  "routh",
-  "reduced integrators on a Routh reduction: routh:<gauss|midpoint|lobatto|trapezoid|prk> (RSPRK), "
-  "routh:dr[:gauss|:lobatto] (discrete Routh equations), routh:classical[:<prk method>]",
-  0,
-  DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  routh_options,
-  routh_alloc, routh_step, routh_jacobian, NULL, NULL, routh_reset, rinteg_free
+static const dm_integrator_type rsprk_type = {
+  .name = "rsprk",
+  .summary = "reduced symplectic PRK (RSPRK) on the shape space of a Routh reduction: gauss "
+    "(stages, default 2), midpoint, lobatto (stages, default 3), trapezoid, prk (tableau); the "
+    "magnetic term in the Newton matrix",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
+  .options = routh_options,
+  .alloc = rsprk_alloc,
+  .step = rsprk_step,
+  .jacobian = rsprk_jacobian,
+  .reset = routh_reset,
+  .free = rinteg_free,
+  .kinds = routh_kinds,
+  .names = rsprk_names,
+};
+
+static const dm_integrator_type dr_type = {
+  .name = "dr",
+  .summary = "discrete Routh equations of a Routh reduction: dr (midpoint L_d), dr:gauss, "
+    "dr:lobatto (Galerkin L_d, stages); no forces or constraints",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
+  .options = routh_options,
+  .alloc = dr_alloc,
+  .step = dr_step,
+  .jacobian = dr_jacobian,
+  .reset = routh_reset,
+  .free = rinteg_free,
+  .kinds = routh_kinds,
+};
+
+static const dm_integrator_type classical_type = {
+  .name = "classical",
+  .summary = "SPRK of the classical Routhian of a Routh reduction with the momentum shift: "
+    "classical (= classical:gauss), classical:<gauss|midpoint|lobatto|trapezoid|prk>",
+  .order = 0,
+  .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
+  .options = routh_options,
+  .alloc = classical_alloc,
+  .step = classical_type_step,
+  .jacobian = classical_type_jacobian,
+  .reset = routh_reset,
+  .free = rinteg_free,
+  .kinds = routh_kinds,
 };
 
 /* {==== public helpers =================================================== */
 
+int dm_routh_register_integrators(dm_err *e)
+{
+  const dm_integrator_type *const types[] = {&rsprk_type, &dr_type, &classical_type};
+  size_t i;
+  int st = DM_OK;
+  for (i = 0; i < 3 && st == DM_OK; i++)
+    st = dm_integrator_register(types[i], e);
+  return st;
+}
+
 int dm_routh_integrator_new(dm_routh *red, const char *method, const dm_integ_opts *opts,
                             dm_integrator **out, dm_err *e)
 {
-  char name[2 * DM_INTEG_STRMAX];
+  int st;
   *out = NULL;
   if (red == NULL || method == NULL)
     return dm_err_set(e, DM_EINVAL, "reduced integrator: no reduction or method");
-  if (strncmp(method, "routh:", 6) == 0)
-    method += 6;
-  if (strlen(method) + 7 > sizeof name || strlen(method) >= DM_INTEG_STRMAX)
-    return dm_err_set(e, DM_EINVAL, "method name '%s' too long", method);
-  snprintf(name, sizeof name, "routh:%s", method);
-  return dm_integrator_new(&red->sys, name, opts, out, e);
+  if ((st = dm_routh_register_integrators(e)) != DM_OK)
+    return st;
+  return dm_integrator_new(&red->sys, method, opts, out, e);
 }
 
 int dm_routh_is_integrator(const dm_integrator *I)
 {
-  return I != NULL && I->type == &dm_integ_routh && I->state != NULL;
+  return I != NULL && I->state != NULL
+         && (I->type == &rsprk_type || I->type == &dr_type || I->type == &classical_type);
 }
 
 int dm_routh_integrator_theta(const dm_integrator *I, double *theta, dm_err *e)
@@ -407,10 +513,9 @@ int dm_routh_integrator_set_theta(dm_integrator *I, const double *theta, dm_err 
 
 const char *dm_routh_integrator_kind(const dm_integrator *I)
 {
-  static const char *const names[] = {"rsprk", "dr", "classical"};
   if (!dm_routh_is_integrator(I))
     return NULL;
-  return names[((const rinteg *)I->state)->kind];
+  return kind_names[((const rinteg *)I->state)->kind];
 }
 
 int dm_routh_symplecticity_defect(dm_integrator *I, double h, const double *x0, const double *s0,

@@ -1,5 +1,6 @@
 /* integ_testsys.h -- small hand-written systems used only by the integrator
- * tests: a non-regular Lagrangian and a non-mechanical one. */
+ * tests: a non-regular Lagrangian, a non-mechanical one and a stiff quartic
+ * well that runs away at large steps. */
 #ifndef DM_INTEG_TESTSYS_H
 #define DM_INTEG_TESTSYS_H
 
@@ -59,6 +60,36 @@ static inline void ts_relativistic(dm_system *s)
   s->npar = 1;
   s->par = ts_rel_par;
   s->lagrangian = ts_rel_lag;
+}
+
+/* Quartic well L = 1/2 v^2 - k q^4 / 4, par[0] = k: at k = 1e12 and a step
+ * of 100 every method runs away (the energy overflows). */
+static inline int ts_quartic_lag(void *data, const double *q, const double *v, const double *par,
+                                 unsigned what, dm_lag_out *o, void *work)
+{
+  double k = par[0], q2 = q[0] * q[0];
+  (void)data; (void)work;
+  if (what & DM_LAG_L) o->L = 0.5 * v[0] * v[0] - 0.25 * k * q2 * q2;
+  if (what & DM_LAG_Q) o->Lq[0] = -k * q2 * q[0];
+  if (what & DM_LAG_V) o->Lv[0] = v[0];
+  if (what & DM_LAG_VV) o->Lvv[0] = 1.0;
+  if (what & DM_LAG_VQ) o->Lvq[0] = 0.0;
+  if (what & DM_LAG_QQ) o->Lqq[0] = -3.0 * k * q2;
+  return 0;
+}
+
+static inline void ts_quartic(dm_system *s, double *k)
+{
+  static const char *const names[] = {"q"}, *const pnames[] = {"k"};
+  memset(s, 0, sizeof *s);
+  s->name = "quartic well";
+  s->n = 1;
+  s->npar = 1;
+  s->coords = names;
+  s->params = pnames;
+  s->par = k;
+  s->flags = DM_SYS_MECHANICAL;
+  s->lagrangian = ts_quartic_lag;
 }
 
 #endif

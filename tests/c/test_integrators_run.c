@@ -234,8 +234,8 @@ static void options_and_registry(void)
   dm_err e;
   double v = 0;
   const char *str = NULL, *variant = NULL;
-  const dm_integrator_type *const *t;
-  const dm_integrator_type *g;
+  const dm_integrator_type *t, *g;
+  size_t i;
   int all = 1;
   dm_integ_opts_init(&o);
   tap_is_int(dm_integ_opts_set_number(&o, "stages", 3, &e), DM_OK, "set stages = 3");
@@ -258,17 +258,122 @@ static void options_and_registry(void)
          "lookup gsl:rk8pd -> type gsl, variant rk8pd");
   tap_ok(dm_integrator_lookup("gaus", NULL) == NULL && dm_integrator_lookup("gausss", NULL) == NULL,
          "lookup needs the exact family name");
-  for (t = dm_integrator_types(); *t; t++) {
+  for (i = 0; (t = dm_integrator_type_at(i)) != NULL; i++) {
     const char *const *on;
-    if (!(*t)->name || !(*t)->summary || !(*t)->alloc || !(*t)->step || !(*t)->free)
+    if (!t->name || !t->summary || !t->alloc || !t->step || !t->free)
       all = 0;
-    for (on = (*t)->options; on && *on; on++)
+    for (on = t->options; on && *on; on++)
       if (dm_integ_option_find(*on) == NULL && strcmp(*on, "tableau") != 0) {
-        tap_diag("%s lists unknown option %s", (*t)->name, *on);
+        tap_diag("%s lists unknown option %s", t->name, *on);
         all = 0;
       }
   }
-  tap_ok(all, "every registered type is complete and lists only known options");
+  tap_ok(all && i == dm_integrator_count() && i >= 8,
+         "every registered type (%zu) is complete and lists only known options", i);
+}
+
+/* {==== registration: a family for another kind of system ================= */
+
+static int copy_alloc(dm_integrator *I, dm_err *e)
+{
+  (void)e;
+  I->state = I;              /* nothing to hold */
+  I->order = 1;
+  I->stages = 3;
+  return DM_OK;
+}
+
+/* q1 = q0 + h p0 (a stand-in; the registry does not care) */
+static int copy_step(dm_integrator *I, double h, const double *q0, const double *p0,
+                     double *q1, double *p1, dm_err *e)
+{
+  size_t i;
+  (void)e;
+  for (i = 0; i < I->n; i++) {
+    q1[i] = q0[i] + h * p0[i];
+    p1[i] = p0[i];
+  }
+  return DM_OK;
+}
+
+static void copy_free(dm_integrator *I) { I->state = NULL; }
+
+static const char *const test_kinds[] = {"test-kind", NULL};
+static const char *const copy_names[] = {"drift", NULL};
+static const dm_integrator_type copy_type = {
+  .name = "gauss", .summary = "a test family answering to gauss and drift on test-kind systems",
+  .alloc = copy_alloc, .step = copy_step, .free = copy_free,
+  .kinds = test_kinds, .names = copy_names
+};
+static const dm_integrator_type clash_same = {
+  .name = "drift", .summary = "clashes with copy_type", .alloc = copy_alloc, .step = copy_step,
+  .kinds = test_kinds
+};
+static const dm_integrator_type clash_core = {
+  .name = "mine", .summary = "answers to midpoint on Lagrangian systems", .alloc = copy_alloc,
+  .step = copy_step, .names = (const char *const[]){"midpoint", NULL}
+};
+static const dm_integrator_type incomplete = {.name = "nostep", .alloc = copy_alloc};
+
+static void registration(void)
+{
+  dm_system s, k;
+  dm_integrator *I = NULL;
+  const char *variant = "x";
+  size_t count = dm_integrator_count();
+  double q = 2.385, p = 0.5;
+  dm_err e;
+  int st;
+  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&k, 1.0, NULL);
+  k.kind = "test-kind";
+  st = dm_integrator_new(&k, "gauss", NULL, &I, &e);
+  tap_ok(st == DM_ENOTFOUND && I == NULL && strstr(e.msg, "method 'gauss' does not apply to system")
+         && strstr(e.msg, "(a test-kind system); it integrates lagrangian systems"),
+         "before registration, 'gauss' on a test-kind system: %s", e.msg);
+  tap_is_int(dm_integrator_register(&copy_type, &e), DM_OK, "a family for test-kind systems registers");
+  tap_is_int(dm_integrator_register(&copy_type, &e), DM_OK, "registering it again is a no-op");
+  tap_ok(dm_integrator_count() == count + 1 && dm_integrator_type_at(count) == &copy_type,
+         "one more family, at the end (%zu)", dm_integrator_count());
+  tap_ok(dm_integrator_find("test-kind", "gauss", &variant) == &copy_type && variant == NULL,
+         "find(test-kind, gauss) is the new family");
+  tap_ok(dm_integrator_find("test-kind", "drift", NULL) == &copy_type, "and so is its further name drift");
+  tap_ok(dm_integrator_lookup("gauss", NULL) != &copy_type && dm_integrator_lookup("drift", NULL) == NULL,
+         "Lagrangian systems still get the core gauss and no drift");
+  tap_ok(dm_integrator_accepts(&copy_type, "test-kind") && !dm_integrator_accepts(&copy_type, NULL)
+         && dm_integrator_accepts(dm_integrator_lookup("rk4", NULL), DM_SYSTEM_LAGRANGIAN),
+         "accepts: by the kinds a family declares");
+  st = dm_integrator_new(&k, "drift", NULL, &I, &e);
+  tap_ok(st == DM_OK && I != NULL && I->type == &copy_type && strcmp(I->name, "drift") == 0
+         && I->stages == 3, "dm_integrator_new on a test-kind system picks the new family by name");
+  if (I != NULL) {
+    st = dm_integrator_step(I, 0.1, &q, &p, &q, &p, &e);
+    tap_ok(st == DM_OK && q == 2.385 + 0.1 * 0.5, "and steps with it");
+  } else {
+    tap_ok(0, "and steps with it");
+  }
+  dm_integrator_free(I);
+  I = NULL;
+  st = dm_integrator_new(&k, "rk4", NULL, &I, &e);
+  tap_ok(st == DM_ENOTFOUND && strstr(e.msg, "method 'rk4' does not apply to system")
+         && strstr(e.msg, "methods here: gauss, drift"), "rk4 on a test-kind system: %s", e.msg);
+  st = dm_integrator_new(&s, "drift", NULL, &I, &e);
+  tap_ok(st == DM_ENOTFOUND && strstr(e.msg, "it integrates test-kind systems"),
+         "drift on a Lagrangian system names the kinds it applies to: %s", e.msg);
+  st = dm_integrator_new(&k, "warp", NULL, &I, &e);
+  tap_ok(st == DM_ENOTFOUND && strstr(e.msg, "unknown integration method 'warp' (known: gauss, drift)"),
+         "an unknown name lists the methods of the kind: %s", e.msg);
+  st = dm_integrator_register(&clash_same, &e);
+  tap_ok(st == DM_EINVAL && strstr(e.msg, "family 'drift' answers to 'drift', which family 'gauss' already has"),
+         "a second family answering to drift for test-kind is refused: %s", e.msg);
+  st = dm_integrator_register(&clash_core, &e);
+  tap_ok(st == DM_EINVAL && strstr(e.msg, "answers to 'midpoint'"),
+         "a family answering to midpoint on Lagrangian systems is refused: %s", e.msg);
+  st = dm_integrator_register(&incomplete, &e);
+  tap_ok(st == DM_EINVAL && strstr(e.msg, "needs a name, alloc and step"), "a family without step: %s", e.msg);
+  tap_ok(dm_integrator_count() == count + 1, "refused families are not added");
+  dm_system_release(&k);
+  dm_system_release(&s);
 }
 
 int main(void)
@@ -279,5 +384,6 @@ int main(void)
   fast_paths();
   errors();
   options_and_registry();
+  registration();
   return tap_done();
 }

@@ -364,9 +364,14 @@ static int roundtrip_same(const dm_traj *a, const dm_traj *b)
   }
   for (i = 0; i < dm_traj_meta_count(a); i++) {
     const char *ka, *va, *kb, *vb;
+    double xa = 0, xb = 0;
+    int na, nb;
     dm_traj_meta_at(a, i, &ka, &va);
     dm_traj_meta_at(b, i, &kb, &vb);
-    if (strcmp(ka, kb) != 0 || strcmp(va, vb) != 0)
+    na = dm_traj_meta_number_at(a, i, &xa);
+    nb = dm_traj_meta_number_at(b, i, &xb);
+    if (strcmp(ka, kb) != 0 || strcmp(va, vb) != 0 || na != nb
+        || (na && !same_bits(xa, xb) && !(isnan(xa) && isnan(xb))))
       return 0;
   }
   return 1;
@@ -478,6 +483,66 @@ static void test_locale(void)
 }
 
 static void expect_load_error(const char *name, const char *text, int status,
+                              const char *needle);
+
+/* Numbers as numbers: kept as doubles, formatted shortest, saved as
+ * "# number" lines of a version 2 file and loaded back bit for bit. */
+static void test_numeric_meta(void)
+{
+  static const char *const c[] = {"x"};
+  dm_traj *tr = dm_traj_alloc(1, c, 0, NULL), *back, *s;
+  double q = 2.385, x = 0;
+  char buf[128];
+  FILE *f;
+  dm_err e;
+  int v2 = 0, line = 0;
+  dm_traj_append(tr, 0.0, &q, NULL, NULL, NULL, NULL);
+  tap_is_int(dm_traj_meta_set_number(tr, "h", 0.05, &e), DM_OK, "set a number");
+  tap_ok(dm_traj_meta_number(tr, "h", &x) && x == 0.05 && strcmp(dm_traj_meta_get(tr, "h"), "0.05") == 0,
+         "it reads back as the double 0.05 and the text \"0.05\"");
+  dm_traj_meta_set_number(tr, "third", 1.0 / 3.0, NULL);
+  dm_traj_meta_set_number(tr, "stages", 3, NULL);
+  dm_traj_meta_set_number(tr, "neg0", -0.0, NULL);
+  dm_traj_meta_set_number(tr, "big", -INFINITY, NULL);
+  dm_traj_meta_set(tr, "label", "0.05", NULL);
+  tap_ok(!dm_traj_meta_number(tr, "label", &x) && !dm_traj_meta_number(tr, "none", &x)
+         && strcmp(dm_traj_meta_get(tr, "third"), "0.3333333333333333") == 0
+         && strcmp(dm_traj_meta_get(tr, "big"), "-inf") == 0,
+         "strings are not numbers; 1/3 and -inf as text: %s, %s", dm_traj_meta_get(tr, "third"),
+         dm_traj_meta_get(tr, "big"));
+  dm_traj_meta_set(tr, "stages", "three", NULL);
+  tap_ok(!dm_traj_meta_number(tr, "stages", NULL) && dm_traj_meta_number_at(tr, 0, NULL)
+         && !dm_traj_meta_number_at(tr, 2, NULL) && !dm_traj_meta_number_at(tr, 99, NULL),
+         "a string replaces a number in place");
+  dm_traj_meta_set_number(tr, "stages", 3, NULL);
+  s = dm_traj_slice(tr, 0, 1, 1, NULL);
+  tap_ok(s != NULL && dm_traj_meta_number(s, "third", &x) && x == 1.0 / 3.0, "slices keep numbers");
+  dm_traj_free(s);
+  tap_is_int(dm_traj_save(tr, path_in("nummeta.csv"), &e), DM_OK, "save");
+  back = dm_traj_load(path_in("nummeta.csv"), &e);
+  tap_ok(back != NULL && roundtrip_same(tr, back) && dm_traj_meta_number(back, "neg0", &x)
+         && signbit(x), "numeric metadata round-trips bit for bit (1/3, -0.0, -inf), strings stay strings");
+  dm_traj_free(back);
+  f = fopen(path_in("nummeta.csv"), "r");
+  while (f != NULL && fgets(buf, sizeof buf, f) && buf[0] == '#') {
+    v2 |= line++ == 0 && strcmp(buf, "# dmech trajectory 2\n") == 0;
+    v2 |= (strcmp(buf, "# number h=0.05\n") == 0) << 1;
+    v2 |= (strcmp(buf, "# meta label=0.05\n") == 0) << 2;
+  }
+  if (f != NULL)
+    fclose(f);
+  tap_is_int(v2, 7, "version 2 file with '# number h=0.05' and '# meta label=0.05' lines");
+  write_file("v1.csv", "# dmech trajectory 1\n# meta h=0.05\n# kinds t\nt\n0\n");
+  back = dm_traj_load(path_in("v1.csv"), &e);
+  tap_ok(back != NULL && !dm_traj_meta_number(back, "h", NULL)
+         && strcmp(dm_traj_meta_get(back, "h"), "0.05") == 0, "a version 1 file loads with strings");
+  dm_traj_free(back);
+  expect_load_error("badnum.csv", "# dmech trajectory 2\n# number h=0.05x\n# kinds t\nt\n",
+                    DM_EINVAL, "badnum.csv:2: '# number' value '0.05x' is not a number");
+  dm_traj_free(tr);
+}
+
+static void expect_load_error(const char *name, const char *text, int status,
                               const char *needle)
 {
   dm_err e;
@@ -515,8 +580,8 @@ static void test_malformed(void)
                     "onlycomments.csv:2: no header line");
   expect_load_error("nokinds.csv", "# dmech trajectory 1\nt,x\n", DM_EINVAL,
                     "nokinds.csv:2: expected a '# kinds' line before the header");
-  expect_load_error("version.csv", "# dmech trajectory 2\n# kinds t\nt\n", DM_EINVAL,
-                    "version.csv:1: unsupported trajectory format version '2'");
+  expect_load_error("version.csv", "# dmech trajectory 3\n# kinds t\nt\n", DM_EINVAL,
+                    "version.csv:1: unsupported trajectory format version '3' (this dmech reads versions 1 and 2)");
   expect_load_error("count.csv", "# dmech trajectory 1\n# kinds t,q\nt,x,y\n", DM_EINVAL,
                     "count.csv:3: the header names 3 columns but '# kinds' lists 2");
   expect_load_error("kind.csv", "# dmech trajectory 1\n# kinds t,q,w\nt,x,y\n", DM_EINVAL,
@@ -667,7 +732,7 @@ static void cleanup(void)
     "emptyf.csv", "blank.csv", "first.csv", "empty.csv", "onlycomments.csv", "nokinds.csv",
     "version.csv", "count.csv", "kind.csv", "pname.csv", "order.csv", "twokinds.csv",
     "meta.csv", "esc.csv", "dupmeta.csv", "dupcol.csv", "headblank.csv", "plain.csv",
-    "keep.csv", NULL
+    "keep.csv", "nummeta.csv", "v1.csv", "badnum.csv", NULL
   };
   int i;
   char cmd[700];
@@ -704,6 +769,7 @@ int main(void)
   test_slice_meta(big);
   test_roundtrip(big);
   test_locale();
+  test_numeric_meta();
   test_malformed();
   test_write_failures(big);
   test_enomem(big);

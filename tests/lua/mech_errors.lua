@@ -16,8 +16,21 @@ local function integ(o) return function() return dm.integrator(kep, o) end end
 
 -- methods and options
 err("bad argument #1 to '.-' %(system expected, got table%)", "not a system", function() dm.integrator({}, {}) end)
-err("dm.integrator: unknown method 'gaus' %(known: midpoint, gauss, trapezoid, lobatto, prk, composition, rk4, gsl:<stepper>",
+err("dm.integrator: unknown integration method 'gaus' %(known: midpoint, gauss, trapezoid, lobatto, prk, composition, rk4, gsl:<stepper>%)$",
     "unknown method lists the known ones", integ{method = "gaus"})
+-- an error from dm.integrator is located at the caller's line (no Lua wrapper
+-- between the user and the C function)
+local function located(what, pattern, f, line)
+  local ok, msg = pcall(f)
+  T.ok(not ok and msg:find("^[^:]*mech_errors%.lua:" .. line .. ": " .. pattern),
+       what .. " names the user's file and line: " .. tostring(msg))
+end
+located("an unknown method", "dm%.integrator: unknown integration method 'gaus'",
+        function() return dm.integrator(kep, {method = "gaus"}) end, debug.getinfo(1, "l").currentline)
+located("a bad option", "dm%.integrator: option 'stages' must be an integer",
+        function() return dm.integrator(kep, {stages = "two"}) end, debug.getinfo(1, "l").currentline)
+located("a bad argument", "bad argument #1 to '[%w.]*integrator' %(system expected, got number%)",
+        function() return dm.integrator(42) end, debug.getinfo(1, "l").currentline)
 err("dm.integrator: unknown option stags %(options: method, tableau, stages, h, tol, maxiter", "misspelt option", integ{stags = 2})
 err("dm.integrator: option 'stages' does not apply to method 'rk4' %(its options: h%)", "option for another method",
     integ{method = "rk4", stages = 2})

@@ -23,8 +23,9 @@ T.ok(t[1] == 2.385 and t[2] == 2.385 + 7 * 0.05 and t[143] == 2.385 + 994 * 0.05
 T.is(table.concat(tr:names(), ","), "t,r,theta,p_r,p_theta,v_r,v_theta,energy,momentum_theta",
      "columns: t, q, p, v, energy and the momentum of the cyclic coordinate")
 local meta = tr:meta()
-T.ok(meta.system == "Kepler (polar)" and meta.method == "gauss" and meta.stages == "2" and meta.h == "0.05"
-     and meta.order == "4" and meta["param.mu"] == "1", "metadata: system, method, stages, h, order, parameters")
+T.ok(meta.system == "Kepler (polar)" and meta.method == "gauss" and meta.stages == 2 and meta.h == 0.05
+     and meta.order == 4 and meta["param.mu"] == 1 and meta.steps == 1000 and meta.status == 0
+     and meta.message == nil, "metadata: system, method, stages, h, order, parameters, how it ended")
 T.ok(tostring(tr):find("Kepler %(polar%) %(gauss s=2 h=0.05%)"), "tostring(traj) shows system and method")
 local Lth, E = tr:momentum("theta"), tr:energy()
 local dL, dE = 0, 0
@@ -43,7 +44,7 @@ T.ok(math.abs(last.r - s.q[1]) < 1e-13 and math.abs(last.p_r - s.p[1]) < 1e-13 a
      "run = 1000 calls of step")
 
 local tt = G2:run({q = {0.4, 0}, p = {0, 0.8}}, {t = 10, every = 10, h = 0.1})
-T.ok(#tt == 11 and tt:column("t")[11] == 10 and tt:meta().h == "0.1", "t = 10 with h = 0.1 in the run options: 100 steps")
+T.ok(#tt == 11 and tt:column("t")[11] == 10 and tt:meta().h == 0.1, "t = 10 with h = 0.1 in the run options: 100 steps")
 local t0 = G2:run(s0, {steps = 0})
 T.ok(#t0 == 1 and t0:column("t")[1] == 2.385, "steps = 0 records the initial state")
 local none = G2:run(s0, {steps = 10, energy = false, momentum = false})
@@ -85,12 +86,33 @@ local apo = {q = {-1.6, 0}, p = {0, 0.5}}
 local ptr, msg = big:run(apo, {steps = 100})
 T.ok(ptr ~= nil and #ptr == 4 and ptr:column("t")[4] == 3 * 0.8, "Newton failure at step 4: the 4 samples before are returned")
 T.ok(type(msg) == "string" and msg:find("^run: step 4 of 100 from t = 2.40*4? failed: Newton") and msg:find("residual")
-     and msg:find("tol") and msg:find("trajectory up to there is returned"), "the message names step, time, residual and tolerance: " .. tostring(msg))
+     and msg:find("tol") and msg:find("trajectory up to there is kept"), "the message names step, time, residual and tolerance: " .. tostring(msg))
 local ptr2, msg2 = big:run(apo, {steps = 100, every = 10})
 T.ok(#ptr2 == 2 and ptr2:column("t")[2] == 3 * 0.8 and msg2:find("step 4 of 100"),
      "every = 10: the last good state (step 3) is kept as well")
 local b3 = dm.integrator(kep, {method = "gauss", stages = 2, h = 0.8}):run(apo, {steps = 3})
 T.ok(b3:column("x")[4] == ptr:column("x")[4], "the last sample is the state after the last good step")
+-- in pieces between progress updates the message still counts from the start
+local ptr3, msg3 = big:run(apo, {steps = 100, every = 10, chunk = 2, progress = true})
+T.ok(#ptr3 == 2 and msg3 == msg2, "chunk = 2: the same samples and message: " .. tostring(msg3))
+T.ok(ptr2:meta().status > 0 and ptr2:meta().steps == 3 and ptr2:meta().message == msg2:sub(6),
+     "the trajectory records how the run ended: status, steps, message (without 'run: ')")
+
+-- runaway: a stiff quartic well at a huge step ends early instead of "succeeding"
+local quartic = dm.system{name = "quartic", coords = {"q"}, L = function(q, v) return 0.5 * v.q^2 - 1e12 * q.q^4 / 4 end}
+for _, m in ipairs{"gauss", "midpoint", "trapezoid", "rk4"} do
+  local tq, mq = dm.integrator(quartic, {method = m, h = 100}):run({q = {1}, v = {0}}, {steps = 100})
+  T.ok(#tq < 101 and type(mq) == "string" and mq:find("trajectory up to there is kept"),
+       m .. ": L = v^2/2 - 1e12 q^4/4 at h = 100 ends early: " .. tostring(mq))
+end
+local unstable = dm.integrator(dm.builtin.harmonic{omega = 1}, {method = "trapezoid", h = 2.385})
+local tu, mu = unstable:run({q = {1}, p = {0}}, {steps = 50, max_energy_error = 1e3})
+T.ok(#tu == 5 and mu:find("^run: the energy error |E %- E0| = [%d.]+ exceeds max_energy_error = 1000 x max%(1, |E0|%) at step 4 of 50"),
+     "max_energy_error: Stormer-Verlet beyond its stability limit stops at step 4: " .. tostring(mu))
+T.ok(#unstable:run({q = {1}, p = {0}}, {steps = 50}) == 51, "without max_energy_error the same run completes")
+T.error_like(function() unstable:run({q = {1}, p = {0}}, {steps = 5, max_energy_error = -1}) end,
+             "run: max_energy_error must be a finite number >= 0", "a negative max_energy_error is refused")
+
 local st, smsg = big:step(k0, 1.5)
 T.ok(st == nil and smsg:find("^step: Newton"), "step: a Newton failure returns nil and a message: " .. tostring(smsg))
 

@@ -119,7 +119,8 @@ T.is(rd.system.params.mu_theta, mu0, "mu is the parameter mu_theta of the reduce
 local R = dm.integrator(rd, {method = "gauss", stages = 2, h = 0.01})
 local C = dm.integrator(rd, {method = "classical", stages = 2, h = 0.01})
 local D = dm.integrator(rd, {method = "dr:gauss", stages = 2, h = 0.01})
-T.is(R.method, "routh:gauss", "dm.integrator(red, {method = 'gauss'}) is RSPRK (routh:gauss)")
+T.ok(R.method == "gauss" and R.family == "rsprk", "dm.integrator(red, {method = 'gauss'}) is RSPRK")
+T.ok(C.family == "classical" and D.family == "dr" and D.method == "dr:gauss", "classical and dr:gauss are their families")
 local tr = R:run(st, {steps = 200, every = 10})
 local tc = C:run(st, {steps = 200, every = 10})
 local td = D:run(st, {steps = 200, every = 10})
@@ -138,7 +139,18 @@ local E = tr:energy()
 local dE = 0
 for k = 1, #E do dE = math.max(dE, math.abs(E[k] - E[1])) end
 T.ok(dE < 1e-8 * math.abs(E[1]), ("reduced energy column conserved (%.2g)"):format(dE))
-T.ok(red:integrator{method = "midpoint", h = 0.1}.method == "routh:midpoint", "red:integrator{...}")
+local M = red:integrator{method = "midpoint", h = 0.1}
+T.ok(M.method == "midpoint" and M.family == "rsprk", "red:integrator{...}")
+-- the reduced system alone: its kind selects the same reduced families
+local R2 = dm.integrator(rd.system, {method = "gauss", stages = 2, h = 0.01})
+T.ok(R2.family == "rsprk" and maxdiff(R2:run(st, {steps = 200, every = 10}), tr, cols) == 0,
+     "dm.integrator(red.system, {method = 'gauss'}) is the same RSPRK run, bit for bit")
+local ms, mr = dm.methods(), dm.methods(rd)
+T.ok(ms.gauss and ms.rk4 and not ms.routh and not ms.rsprk and not ms.dr and not ms.classical,
+     "dm.methods() lists the Lagrangian methods only (no routh, rsprk, dr, classical)")
+T.ok(mr.gauss and mr.gauss:find("RSPRK") and mr.dr and mr.classical and mr.rsprk and not mr.rk4
+     and dm.methods("routh").dr == mr.dr and dm.methods(rd.system).classical == mr.classical,
+     "dm.methods(red | red.system | \"routh\") lists the reduced families")
 
 -- reconstruction = the unreduced run ------------------------------------------
 local full = rd:reconstruct(tr, {theta = 0.3})
@@ -228,9 +240,18 @@ T.error_like(function() dm.routh(sat, {cyclic = "theta", mu = {1, 2}}) end, "len
 T.error_like(function() dm.routh(sat, {cyclic = {"theta"}, tol = 1}) end, "unknown option", "unknown option")
 T.error_like(function() dm.routh(sat, {}) end, "cyclic", "cyclic coordinates required")
 T.error_like(function() dm.routh(dm.builtin.kepler{}, {cyclic = {"x"}}) end, "Lagrangian", "built-in C systems have no expressions")
-T.error_like(function() dm.integrator(red, {method = "rk4"}) end, "unknown reduced method 'rk4'", "non-reduced methods are refused on a reduction")
-T.error_like(function() dm.integrator(red.system, {method = "gauss"}) end, "give the Routh reduction",
-  "the reduced system alone is not integrated with core methods (the magnetic term would be lost)")
+do
+  local line = debug.getinfo(1, "l").currentline + 1
+  local ok, msg = pcall(function() return dm.integrator(red, {method = "rk4"}) end)
+  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. line .. ": dm%.integrator: method 'rk4' does not apply to system '[^']*' %(a routh system%); it integrates lagrangian systems %(methods here: rsprk, gauss, midpoint, lobatto, trapezoid, prk, dr, classical%)$"),
+       "non-reduced methods are refused on a reduction, at the user's line: " .. tostring(msg))
+  ok, msg = pcall(function() return dm.integrator(red.system, {method = "rk4"}) end)
+  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. (line + 3) .. ": dm%.integrator: method 'rk4' does not apply"),
+       "and on its reduced system (the magnetic term would be lost): " .. tostring(msg))
+  ok, msg = pcall(function() return dm.integrator(sat, {method = "dr"}) end)
+  T.ok(not ok and msg:find("dm.integrator: method 'dr' does not apply to system '[^']*' %(a lagrangian system%); it integrates routh systems"),
+       "a reduced method on an unreduced system says what it integrates: " .. tostring(msg))
+end
 T.error_like(function() return red.nonsense end, "no field or method 'nonsense'", "unknown field")
 T.ok(dm.docs()["dm.routh"] and dm.docs()["routh:reconstruct"] and dm.docs()["routh.beta"], "documented")
 

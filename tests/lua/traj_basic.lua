@@ -70,13 +70,17 @@ T.ok(count == N and last == t[N], "ipairs walks every sample")
 
 -- metadata
 local m = tr:meta()
-T.ok(m.system == "Kepler (polar)" and m.method == "gauss" and m.stages == "2" and m.h == "0.05",
-     "meta() as strings (numbers round-trip)")
-T.is(tr:meta("h"), "0.05", "meta(key)")
+T.ok(m.system == "Kepler (polar)" and m.method == "gauss" and m.stages == 2 and m.h == 0.05
+     and math.type(m.stages) == "integer" and math.type(m.h) == "float",
+     "meta(): strings as strings, numbers as numbers")
+T.is(tr:meta("h"), 0.05, "meta(key)")
 T.ok(rawequal(tr:meta("note", 2.385), tr), "meta(key, value) sets and returns traj")
-T.is(tr:meta("note"), "2.385", "number metadata keeps every digit")
+T.is(tr:meta("note"), 2.385, "number metadata keeps every digit")
 tr:meta("note", 1 / 3)
-T.is(tonumber(tr:meta("note")), 1 / 3, "1/3 stored exactly")
+T.is(tr:meta("note"), 1 / 3, "1/3 stored exactly")
+tr:meta("label", "2.385")
+T.is(tr:meta("label"), "2.385", "a string that looks like a number stays a string")
+tr:meta("label", nil)
 tr:meta("note", nil)
 T.is(tr:meta("note"), nil, "meta(key, nil) removes")
 

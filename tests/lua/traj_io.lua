@@ -34,16 +34,17 @@ T.is(1 / back:column("x")[4], -math.huge, "-0.0 keeps its sign")
 T.is(table.concat(back:names(), ","), table.concat(tr:names(), ","), "names round-trip")
 T.is(back:kinds().energy, "diag", "kinds round-trip")
 local m = back:meta()
-T.ok(m.system == 'Kepler "e=0.6"' and m.note == "line1\nline2\\tab\t" and m.h == "0.01",
-     "metadata with quotes, newline, backslash and tab round-trips")
+T.ok(m.system == 'Kepler "e=0.6"' and m.note == "line1\nline2\\tab\t" and m.h == 0.01,
+     "metadata with quotes, newline, backslash and tab round-trips, numbers as numbers")
 T.is(tostring(back), tostring(tr), "tostring identical after the round trip")
 
 -- the file: magic, metadata comments, kinds, header, %.17g numbers
 local f = assert(io.open(file))
 local text = f:read("a")
 f:close()
-T.ok(text:find("^# dmech trajectory 1\n"), "first line is the format magic")
+T.ok(text:find("^# dmech trajectory 2\n"), "first line is the format magic (version 2: numeric metadata)")
 T.ok(text:find("\n# meta note=line1\\nline2\\\\tab\\t\n", 1, true), "escaped metadata line")
+T.ok(text:find("\n# number h=0.01\n", 1, true), "numeric metadata line")
 T.ok(text:find("\n# kinds t,q,q,p,p,diag\nt,x,y,p_x,p_y,energy\n", 1, true), "kinds and header lines")
 T.ok(text:find("\n0.10000000000000001,2.3849999999999998,", 1, true), "numbers as %.17g")
 

@@ -24,7 +24,7 @@ out=$(cat "$T/out"); err=$(cat "$T/err")
 like "$err" "run: step [0-9]+/4000000000 \( *[0-9.]+%\)  t = .* steps/s  ETA" "progress line on stderr"
 is "$st" 0 "the script finished normally after Ctrl-C"
 like "$out" "^true	true	true" "the partial trajectory is returned"
-like "$out" "run: interrupted after step [0-9]+ of 4000000000 \(t = [0-9.e+]+\); the trajectory up to there is returned" \
+like "$out" "run: interrupted after step [0-9]+ of 4000000000 \(t = [0-9.e+]+\); the trajectory up to there is kept" \
   "the message says where the run stopped"
 like "$out" "after the run	0.01" "the session goes on (the interrupt was consumed)"
 if printf '%s\n' "$err" | grep -q "interrupted!"; then ok 1 "no Lua 'interrupted!' error"; else ok 0 "no Lua 'interrupted!' error"; fi
