@@ -562,8 +562,11 @@ function T._capture(f)
 end
 
 -- The child of `dmech test`: run one file, then done(); an error outside
--- any group goes to stderr and exits with status 2 (no plan line).
-function T._run_file(path)
+-- any group goes to stderr and exits with status 2 (no plan line).  The TAP
+-- goes to descriptor fd when given (what the file prints stays apart).
+function T._run_file(path, fd)
+  local tap = fd and io.open("/dev/fd/" .. fd, "w")
+  if tap then state.write = function(s) tap:write(s); tap:flush() end end
   local chunk, err = loadfile(path)
   if chunk == nil then
     io.stderr:write(err, "\n")

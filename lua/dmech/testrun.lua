@@ -2,7 +2,8 @@
 --
 -- Finds every *_test.lua under the directories (and takes the files named),
 -- runs each in a fresh dmech process (dm.test's _run_file: the file, then
--- done()), several at a time, reads the TAP each one prints and reports per
+-- done(), the TAP on descriptor 3 so that what the file prints is never
+-- taken for a test line), several at a time, reads the TAP and reports per
 -- file in the order of the files -- the same report whatever the number of
 -- jobs -- then a summary.  The processes, directory listings and clock come
 -- from src/app/testrun.c as `sys`.
@@ -154,8 +155,6 @@ local function parse(text)
       elseif dir == "TODO" then r.todo = r.todo + 1
       elseif cur.ok then r.passed = r.passed + 1
       else r.failed = r.failed + 1 end
-    elseif line:match("^Bail out!") then
-      r.bail = line:match("^Bail out!%s*(.-)%s*$")
     elseif line:match("^#") and cur then
       cur.diag[#cur.diag + 1] = line
     end
@@ -165,7 +164,7 @@ end
 
 -- What became of a file: "pass" | "fail" | "error" | "skip", with a reason.
 local function classify(job)
-  local r = parse(job.out)
+  local r = parse(job.tap ~= "" and job.tap or job.out)
   job.r = r
   local ntests = #r.tests
   local function plural(n, what) return n .. " " .. what .. (n == 1 and "" or "s") end
@@ -173,7 +172,6 @@ local function classify(job)
   if job.how == "signal" then
     return "error", ("killed by signal %d after %s"):format(job.code, plural(ntests, "test"))
   end
-  if r.bail then return "error", "bailed out: " .. r.bail end
   if r.plan == nil then
     if job.code == 2 then return "error", "raised an error after " .. plural(ntests, "test") end
     return "error", ("exit status %d without a plan after %s"):format(job.code, plural(ntests, "test"))
@@ -210,7 +208,7 @@ local function human_file(out, job, verbose)
   local secs = job.status == "skip" and "" or ("; %.2f s"):format(job.secs)
   out(("%s %s (%s%s)\n"):format(LABEL[job.status], job.path, job.reason, secs))
   if verbose then
-    indent(out, lines(job.out), "      ")
+    indent(out, lines(job.tap), "      ")
   elseif job.status == "fail" or job.status == "error" then
     for _, t in ipairs(job.r.tests) do
       if not t.ok and t.dir == nil then
@@ -219,9 +217,13 @@ local function human_file(out, job, verbose)
       end
     end
   end
-  if job.err ~= "" and (verbose or job.status == "fail" or job.status == "error") then
-    out("      stderr:\n")
-    indent(out, lines(job.err), "      | ", not verbose and 40 or nil)
+  for _, stream in ipairs{"out", "err"} do
+    local text = job[stream]
+    if text ~= "" and (stream == "err" or job.tap ~= "")
+       and (verbose or job.status == "fail" or job.status == "error") then
+      out("      std" .. stream .. ":\n")
+      indent(out, lines(text), "      | ", not verbose and 40 or nil)
+    end
   end
 end
 
@@ -242,8 +244,13 @@ local function tap_file(out, job, state)
     for _, d in ipairs(t.diag) do out(d .. "\n") end
   end
   if job.status == "error" then line(false, job.path .. ": " .. job.reason) end
-  if job.err ~= "" and (job.status == "error" or job.status == "fail") then
-    indent(out, lines(job.err), "# ")
+  if job.status == "error" or job.status == "fail" then
+    for _, stream in ipairs{"out", "err"} do
+      if job[stream] ~= "" and (stream == "err" or job.tap ~= "") then
+        out("# std" .. stream .. ":\n")
+        indent(out, lines(job[stream]), "#   ")
+      end
+    end
   end
 end
 
@@ -304,27 +311,27 @@ function M.main(args, sys)
   local jobs, argvs = {}, {}
   for k, path in ipairs(files) do
     jobs[k] = {path = path}
-    argvs[k] = {exe, "-e", ('require("dmech.test")._run_file(%q)'):format(path)}
+    argvs[k] = {exe, "-e", ('require("dmech.test")._run_file(%q, 3)'):format(path)}
   end
   local njobs = math.min(o.jobs or ncpu, #files)
   local out = function(s) io.stdout:write(s) end
-  local tap = {n = 0}
+  local tapstate = {n = 0}
   local printed = 0
   local t0 = sys.clock()
-  local interrupted = sys.run(argvs, njobs, function(k, how, code, stdout, stderr, secs)
+  local interrupted = sys.run(argvs, njobs, function(k, how, code, stdout, stderr, tap, secs)
     local job = jobs[k]
-    job.how, job.code, job.out, job.err, job.secs = how, code, stdout, stderr, secs
+    job.how, job.code, job.out, job.err, job.tap, job.secs = how, code, stdout, stderr, tap, secs
     job.status, job.reason = classify(job)
     -- report in file order, whatever order the files finish in
     while jobs[printed + 1] and jobs[printed + 1].status do
       printed = printed + 1
-      if o.tap then tap_file(out, jobs[printed], tap) else human_file(out, jobs[printed], o.verbose) end
+      if o.tap then tap_file(out, jobs[printed], tapstate) else human_file(out, jobs[printed], o.verbose) end
     end
     io.stdout:flush()
   end)
   local line, slow, files_by = summary(jobs, #files, sys.clock() - t0, njobs, interrupted)
   if o.tap then
-    out("1.." .. tap.n .. "\n")
+    out("1.." .. tapstate.n .. "\n")
     out("# " .. line:gsub("\n", "\n# ") .. "\n")
   else
     out(line .. "\n" .. slow .. "\n")

@@ -2,10 +2,11 @@
  * Lua runner (lua/dmech/testrun.lua), in a Lua state of its own.
  *
  * sys.run(jobs, parallel, on_done) starts every job (an argv list) as a child
- * with stdin from /dev/null and stdout, stderr piped, at most `parallel` at
- * once, in the order given; as each one ends it calls
- * on_done(i, how, code, stdout, stderr, seconds), how = "exit" | "signal" |
- * "spawn" (could not start: stderr says why).  Children stay in our process
+ * with stdin from /dev/null and stdout, stderr and descriptor 3 piped (3
+ * carries the TAP, so what a test prints cannot be taken for a test line),
+ * at most `parallel` at once, in the order given; as each one ends it calls
+ * on_done(i, how, code, stdout, stderr, tap, seconds), how = "exit" |
+ * "signal" | "spawn" (could not start: stderr says why).  Children stay in our process
  * group, so Ctrl-C at the terminal reaches them; a SIGINT also stops new
  * starts, is passed on to the running children, and makes run() return true
  * once they ended.  A second one ends the runner.
@@ -45,6 +46,7 @@ extern char **environ;
 #define DIR_MT "dmech.testrun.dir"
 #define READ_CHUNK 65536
 #define SLICE_MS 100         /* poll slice: exits behind held pipes, SIGINT */
+#define NSTREAM 3            /* stdout, stderr, TAP (descriptor 3 in the child) */
 
 static double now(void)
 {
@@ -77,8 +79,8 @@ typedef struct outbuf {
 typedef struct slot {
   int job;             /* 1-based job index; 0 = free */
   pid_t pid;           /* > 0 until reaped */
-  int fd[2];           /* read ends of stdout and stderr; -1 once closed */
-  outbuf out[2];
+  int fd[NSTREAM];     /* read ends of stdout, stderr, TAP; -1 once closed */
+  outbuf out[NSTREAM];
   double t0;
 } slot;
 
@@ -86,7 +88,7 @@ typedef struct pool {
   int n;
   int sigset;                 /* SIGINT handler installed: old is valid */
   struct sigaction old;
-  struct pollfd *pfd;         /* 2 n entries, after the slots */
+  struct pollfd *pfd;         /* NSTREAM n entries, after the slots */
   int *owner;                 /* slot of each pfd entry */
   slot s[];
 } pool;
@@ -114,12 +116,13 @@ static void slot_clear(slot *s, int kill_child)
       kill(s->pid, SIGKILL);
     reap(s->pid, &st);
   }
-  for (i = 0; i < 2; i++) {
+  for (i = 0; i < NSTREAM; i++) {
     close_fd(&s->fd[i]);
     free(s->out[i].p);
   }
   memset(s, 0, sizeof *s);
-  s->fd[0] = s->fd[1] = -1;
+  for (i = 0; i < NSTREAM; i++)
+    s->fd[i] = -1;
 }
 
 static void pool_release(pool *p)
@@ -169,16 +172,17 @@ static int drain(slot *s, int i)
   }
 }
 
-/* A pipe whose ends are >= 3 and close-on-exec (dup2 onto 1 and 2 in the
- * child then clears the flag as it must). */
+/* A pipe whose ends are >= 4 and close-on-exec (dup2 onto 1, 2 and 3 in
+ * the child never meets the same descriptor and clears the flag as it
+ * must). */
 static int pipe_hi(int fds[2])
 {
   int i;
   if (pipe2(fds, O_CLOEXEC) != 0)
     return -1;
   for (i = 0; i < 2; i++) {
-    if (fds[i] < 3) {
-      int hi = fcntl(fds[i], F_DUPFD_CLOEXEC, 3);
+    if (fds[i] < 4) {
+      int hi = fcntl(fds[i], F_DUPFD_CLOEXEC, 4);
       if (hi < 0) {
         close(fds[0]);
         close(fds[1]);
@@ -194,23 +198,25 @@ static int pipe_hi(int fds[2])
 /* Start argv in slot s; 0 or an errno. */
 static int slot_start(slot *s, char **argv)
 {
-  int out[2] = {-1, -1}, err[2] = {-1, -1}, rc, i;
+  int fds[NSTREAM][2], rc = 0, i, k;
   posix_spawn_file_actions_t fa;
   posix_spawnattr_t at;
   sigset_t def, none;
   pid_t pid;
-  if (pipe_hi(out) != 0)
-    return errno;
-  if (pipe_hi(err) != 0) {
-    rc = errno;
-    close(out[0]);
-    close(out[1]);
-    return rc;
+  for (i = 0; i < NSTREAM; i++) {
+    if (pipe_hi(fds[i]) != 0) {
+      rc = errno;
+      for (k = 0; k < i; k++) {
+        close(fds[k][0]);
+        close(fds[k][1]);
+      }
+      return rc;
+    }
   }
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_adddup2(&fa, out[1], STDOUT_FILENO);
-  posix_spawn_file_actions_adddup2(&fa, err[1], STDERR_FILENO);
+  for (i = 0; i < NSTREAM; i++)
+    posix_spawn_file_actions_adddup2(&fa, fds[i][1], STDOUT_FILENO + i);
   posix_spawnattr_init(&at);
   posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
   sigemptyset(&def);
@@ -226,18 +232,18 @@ static int slot_start(slot *s, char **argv)
     rc = posix_spawnp(&pid, argv[0], &fa, &at, argv, environ);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&at);
-  close(out[1]);
-  close(err[1]);
-  if (rc != 0) {
-    close(out[0]);
-    close(err[0]);
-    return rc;
+  for (i = 0; i < NSTREAM; i++) {
+    close(fds[i][1]);
+    if (rc != 0)
+      close(fds[i][0]);
   }
+  if (rc != 0)
+    return rc;
   s->pid = pid;
-  s->fd[0] = out[0];
-  s->fd[1] = err[0];
-  for (i = 0; i < 2; i++)
+  for (i = 0; i < NSTREAM; i++) {
+    s->fd[i] = fds[i][0];
     fcntl(s->fd[i], F_SETFL, fcntl(s->fd[i], F_GETFL) | O_NONBLOCK);
+  }
   s->t0 = now();
   return 0;
 }
@@ -258,15 +264,16 @@ static int pool_error(lua_State *L, pool *p, const char *what)
 static void finish(lua_State *L, pool *p, slot *s, const char *how, int code,
                    double secs)
 {
+  int i;
   lua_pushvalue(L, ON_DONE);
   lua_pushinteger(L, s->job);
   lua_pushstring(L, how);
   lua_pushinteger(L, code);
-  lua_pushlstring(L, s->out[0].p != NULL ? s->out[0].p : "", s->out[0].len);
-  lua_pushlstring(L, s->out[1].p != NULL ? s->out[1].p : "", s->out[1].len);
+  for (i = 0; i < NSTREAM; i++)
+    lua_pushlstring(L, s->out[i].p != NULL ? s->out[i].p : "", s->out[i].len);
   lua_pushnumber(L, secs);
   slot_clear(s, 0);
-  if (lua_pcall(L, 6, 0, 0) != LUA_OK) {
+  if (lua_pcall(L, 4 + NSTREAM, 0, 0) != LUA_OK) {
     pool_release(p);
     lua_error(L);
   }
@@ -278,11 +285,11 @@ static void ended(lua_State *L, pool *p, slot *s, int st)
   double secs = now() - s->t0;
   int i;
   s->pid = 0;
-  for (i = 0; i < 2; i++)
+  for (i = 0; i < NSTREAM; i++) {
     if (s->fd[i] >= 0 && drain(s, i) < 0)
       pool_error(L, p, "not enough memory for a test's output");
-  close_fd(&s->fd[0]);    /* a grandchild may still hold them: not waited for */
-  close_fd(&s->fd[1]);
+    close_fd(&s->fd[i]);  /* a grandchild may still hold it: not waited for */
+  }
   if (WIFSIGNALED(st))
     finish(L, p, s, "signal", WTERMSIG(st), secs);
   else
@@ -302,7 +309,8 @@ static void start_job(lua_State *L, pool *p, slot *s, int job, char **argv)
   argv[n] = NULL;
   lua_pop(L, 1);
   memset(s, 0, sizeof *s);
-  s->fd[0] = s->fd[1] = -1;
+  for (k = 0; k < NSTREAM; k++)
+    s->fd[k] = -1;
   s->job = job;
   rc = slot_start(s, argv);
   if (rc != 0) {
@@ -319,31 +327,37 @@ static int poll_set(pool *p)
 {
   int i, j, m = 0;
   for (i = 0; i < p->n; i++)
-    for (j = 0; j < 2; j++)
+    for (j = 0; j < NSTREAM; j++)
       if (p->s[i].job != 0 && p->s[i].fd[j] >= 0) {
         p->pfd[m].fd = p->s[i].fd[j];
         p->pfd[m].events = POLLIN;
         p->pfd[m].revents = 0;
-        p->owner[m++] = i * 2 + j;
+        p->owner[m++] = i * NSTREAM + j;
       }
   return m;
 }
 
-/* 1 when a child closed both pipes but was not reaped yet: it is exiting,
- * look again soon. */
+/* 1 when a child closed all its pipes but was not reaped yet: it is
+ * exiting, look again soon. */
 static int exiting(const pool *p)
 {
-  int i;
-  for (i = 0; i < p->n; i++)
-    if (p->s[i].job != 0 && p->s[i].pid > 0 && p->s[i].fd[0] < 0 && p->s[i].fd[1] < 0)
+  int i, j;
+  for (i = 0; i < p->n; i++) {
+    const slot *s = &p->s[i];
+    if (s->job == 0 || s->pid <= 0)
+      continue;
+    for (j = 0; j < NSTREAM && s->fd[j] < 0; j++)
+      ;
+    if (j == NSTREAM)
       return 1;
+  }
   return 0;
 }
 
 static int l_run(lua_State *L)
 {
   lua_Integer njobs, parallel, next = 1;
-  int i, maxargs = 1, running = 0, forwarded = 0;
+  int i, j, maxargs = 1, running = 0, forwarded = 0;
   size_t size;
   pool *p;
   char **argv;
@@ -375,14 +389,15 @@ static int l_run(lua_State *L)
     parallel = njobs > 0 ? njobs : 1;
 
   size = sizeof(pool) + (size_t)parallel * sizeof(slot)
-         + 2 * (size_t)parallel * (sizeof(struct pollfd) + sizeof(int));
+         + NSTREAM * (size_t)parallel * (sizeof(struct pollfd) + sizeof(int));
   p = lua_newuserdatauv(L, size, 0);
   memset(p, 0, size);
   p->n = (int)parallel;
   p->pfd = (struct pollfd *)(void *)&p->s[parallel];
-  p->owner = (int *)(void *)&p->pfd[2 * parallel];
+  p->owner = (int *)(void *)&p->pfd[NSTREAM * parallel];
   for (i = 0; i < p->n; i++)
-    p->s[i].fd[0] = p->s[i].fd[1] = -1;
+    for (j = 0; j < NSTREAM; j++)
+      p->s[i].fd[j] = -1;
   if (luaL_newmetatable(L, POOL_MT)) {
     lua_pushcfunction(L, pool_gc);
     lua_setfield(L, -2, "__gc");
@@ -420,8 +435,9 @@ static int l_run(lua_State *L)
       return pool_error(L, p, strerror(errno));
     for (i = 0; rc > 0 && i < m; i++)
       if (p->pfd[i].revents != 0) {
-        slot *s = &p->s[p->owner[i] / 2];
-        if (s->fd[p->owner[i] % 2] >= 0 && drain(s, p->owner[i] % 2) < 0)
+        slot *s = &p->s[p->owner[i] / NSTREAM];
+        j = p->owner[i] % NSTREAM;
+        if (s->fd[j] >= 0 && drain(s, j) < 0)
           return pool_error(L, p, "not enough memory for a test's output");
       }
     for (i = 0; i < p->n; i++) {
