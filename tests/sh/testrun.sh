@@ -4,7 +4,8 @@
 # and the example suite in examples/tests passes.
 . "$DMECH_SRCDIR/tests/sh/tap.sh"
 D="$DMECH"
-T="$DMECH_TESTTMP/testrun"; rm -rf "$T"; mkdir -p "$T/suite/sub" "$T/suite/.hidden"
+# hidden: `dmech test` at the top of an in-tree build must not find these
+T="$DMECH_TESTTMP/.testrun"; rm -rf "$T"; mkdir -p "$T/suite/sub" "$T/suite/.hidden"
 cd "$T" || exit 1
 
 cat > suite/pass_test.lua <<'LUA'
