@@ -41,8 +41,9 @@ dm_expr_ctx *dm_expr_ctx_alloc(void)
   ctx->hcap = 1024;
   ctx->ntcap = 64;
   ctx->htab = malloc(ctx->hcap * sizeof *ctx->htab);
+  ctx->htag = malloc(ctx->hcap * sizeof *ctx->htag);
   ctx->ntab = malloc(ctx->ntcap * sizeof *ctx->ntab);
-  if (ctx->htab == NULL || ctx->ntab == NULL) {
+  if (ctx->htab == NULL || ctx->htag == NULL || ctx->ntab == NULL) {
     dm_expr_ctx_free(ctx);
     return NULL;
   }
@@ -62,6 +63,7 @@ void dm_expr_ctx_free(dm_expr_ctx *ctx)
   free(ctx->node);
   free(ctx->cval);
   free(ctx->htab);
+  free(ctx->htag);
   free(ctx->ntab);
   free(ctx->memo);
   free(ctx->stamp);
@@ -108,18 +110,26 @@ static int rehash(dm_expr_ctx *ctx)
 {
   size_t cap = ctx->hcap * 2;
   int32_t *t = malloc(cap * sizeof *t);
-  if (t == NULL)
+  uint32_t *g = malloc(cap * sizeof *g);
+  if (t == NULL || g == NULL) {
+    free(t);
+    free(g);
     return -1;
+  }
   memset(t, 0xff, cap * sizeof *t);
   for (size_t i = 0; i < ctx->n; i++) {
     const dm_node *nd = &ctx->node[i];
-    size_t j = node_hash(ctx, nd->op, nd->a, nd->b, nd->c) & (cap - 1);
+    uint64_t h = node_hash(ctx, nd->op, nd->a, nd->b, nd->c);
+    size_t j = h & (cap - 1);
     while (t[j] >= 0)
       j = (j + 1) & (cap - 1);
     t[j] = (int32_t)i;
+    g[j] = (uint32_t)(h >> 32);
   }
   free(ctx->htab);
+  free(ctx->htag);
   ctx->htab = t;
+  ctx->htag = g;
   ctx->hcap = cap;
   return 0;
 }
@@ -131,9 +141,12 @@ static dm_expr cons(dm_expr_ctx *ctx, int op, int32_t a, int32_t b, int32_t c)
   if (2 * (ctx->n + 1) > ctx->hcap && rehash(ctx) != 0)
     return oom(ctx);
   size_t mask = ctx->hcap - 1;
-  size_t j = node_hash(ctx, op, a, b, c) & mask;
-  for (; ctx->htab[j] >= 0; j = (j + 1) & mask)
-    if (node_equal(ctx, &ctx->node[ctx->htab[j]], op, a, b, c))
+  uint64_t h = node_hash(ctx, op, a, b, c);
+  uint32_t tag = (uint32_t)(h >> 32);
+  size_t j = h & mask;
+  for (; ctx->htab[j] >= 0; j = (j + 1) & mask)   /* the tag spares a */
+    if (ctx->htag[j] == tag &&                    /* look at the node */
+        node_equal(ctx, &ctx->node[ctx->htab[j]], op, a, b, c))
       return ctx->htab[j];
   if (ctx->n >= (size_t)INT32_MAX - 1)
     return dm_expr__fail(ctx, DM_ENOMEM, "expression: too many nodes");
@@ -168,6 +181,7 @@ static dm_expr cons(dm_expr_ctx *ctx, int op, int32_t a, int32_t b, int32_t c)
   if (op == DM_EXPR_CONST)
     ctx->ncval++;            /* the tentative value becomes permanent */
   ctx->htab[j] = (int32_t)ctx->n;
+  ctx->htag[j] = tag;
   return (dm_expr)ctx->n++;
 }
 
@@ -181,9 +195,10 @@ static dm_expr find(const dm_expr_ctx *ctx, int op, int32_t a, int32_t b,
                     int32_t c)
 {
   size_t mask = ctx->hcap - 1;
-  for (size_t j = node_hash(ctx, op, a, b, c) & mask; ctx->htab[j] >= 0;
-       j = (j + 1) & mask)
-    if (node_equal(ctx, &ctx->node[ctx->htab[j]], op, a, b, c))
+  uint64_t h = node_hash(ctx, op, a, b, c);
+  uint32_t tag = (uint32_t)(h >> 32);
+  for (size_t j = h & mask; ctx->htab[j] >= 0; j = (j + 1) & mask)
+    if (ctx->htag[j] == tag && node_equal(ctx, &ctx->node[ctx->htab[j]], op, a, b, c))
       return ctx->htab[j];
   return DM_EXPR_NONE;
 }

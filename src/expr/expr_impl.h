@@ -55,6 +55,7 @@ struct dm_expr_ctx {
   double *cval;             /* constant values */
   size_t ncval, capcval;
   int32_t *htab;            /* cons table: node handles, -1 empty */
+  uint32_t *htag;           /* the high half of each entry's hash */
   size_t hcap;              /* power of two */
   char **names;             /* symbol / parameter names */
   size_t nnames, capnames;
@@ -191,6 +192,13 @@ dm_expr dm_expr__probe(dm_expr_ctx *ctx, uint64_t h, int prod,
                        const dm_nel *E, size_t n);
 int dm_expr__reg(dm_expr_ctx *ctx, uint64_t h, dm_expr e);
 
+/* Terms of a sum (prod 0; through a constant coefficient) or factors of a
+ * product (prod 1) as far as the node records them; 1 for other nodes. */
+size_t dm_expr__nlen(const dm_expr_ctx *ctx, dm_expr e, int prod);
+/* The normal sum of t[0..k) at once (the node adding them one by one
+ * gives, up to where a common coefficient is taken out), in time about
+ * linear in the number of terms. */
+dm_expr dm_expr__sum_n(dm_expr_ctx *ctx, size_t k, const dm_expr *t);
 /* The constant node x (as dm_expr_const). */
 dm_expr dm_expr__k(dm_expr_ctx *ctx, double x);
 /* Release the normal-form buffers and table (expr_norm.c). */

@@ -42,6 +42,7 @@
 #define EXP_LIMIT ((int64_t)1 << 30)
 
 #define K(x) dm_expr__k(ctx, (x))
+#define nlen dm_expr__nlen
 #define isc dm_expr__isc
 #define sumlike dm_expr__sumlike
 #define grow dm_expr__grow
@@ -71,8 +72,13 @@ void dm_expr__norm_free(dm_expr_ctx *ctx)
 }
 
 /* Elements of a sum / factors of a product, as far as known. */
-static size_t nlen(const dm_expr_ctx *ctx, dm_expr e, int prod)
+size_t dm_expr__nlen(const dm_expr_ctx *ctx, dm_expr e, int prod)
 {
+  double c;
+  while (ctx->node[e].op == NEG)
+    e = ctx->node[e].a;
+  if (!prod && ctx->node[e].op == MUL && isc(ctx, ctx->node[e].a, &c))
+    e = ctx->node[e].b;          /* c*(sum): the sum's terms */
   while (ctx->node[e].op == NEG)
     e = ctx->node[e].a;
   const dm_node *nd = &ctx->node[e];
@@ -243,6 +249,73 @@ static dm_expr long_sum(dm_expr_ctx *ctx, dm_expr a, dm_expr b, int sb,
 static dm_expr build_sum(dm_expr_ctx *ctx, size_t n, size_t k, int hc,
                          dm_flat *f);
 
+/* Reorder ctx->nel[0][0..n) so that the elements of the first operand
+ * (src 0) come first, each group in its order: an expanded c*(sum)
+ * appended its terms at the end, and the sum built before is then found
+ * as the prefix (one new node per added term). */
+static void stable_by_src(dm_expr_ctx *ctx, size_t n)
+{
+  dm_nel *E = ctx->nel[0];
+  size_t k = 0;
+  while (k < n && E[k].src == 0)
+    k++;
+  for (size_t i = k + 1; i < n; i++)
+    if (E[i].src == 0) {
+      dm_nel t = E[i];
+      memmove(E + k + 1, E + k, (i - k) * sizeof *E);
+      E[k++] = t;
+    }
+}
+
+/* An element's place in the sort of merge_like. */
+typedef struct elix {
+  int32_t key, k;
+  size_t i;
+} elix;
+
+static int cmp_ix(const void *x, const void *y)
+{
+  const elix *a = x, *b = y;
+  if (a->key != b->key)
+    return a->key < b->key ? -1 : 1;
+  if (a->k != b->k)
+    return a->k < b->k ? -1 : 1;
+  return (a->i > b->i) - (a->i < b->i);
+}
+
+/* Like terms of ctx->nel[0][0..f->n) collected into their first
+ * occurrence (coefficients added in the order they appear), by sorting an
+ * index: what flattening with merge does, without its linear search per
+ * element (used for long lists). */
+static int merge_like(dm_expr_ctx *ctx, dm_flat *f)
+{
+  size_t n = f->n;
+  if (n < 2)
+    return 0;
+  elix *t = malloc(n * sizeof *t);
+  if (t == NULL)
+    return -1;
+  dm_nel *E = ctx->nel[0];
+  for (size_t i = 0; i < n; i++)
+    t[i] = (elix){ E[i].key, E[i].k, i };
+  qsort(t, n, sizeof *t, cmp_ix);
+  for (size_t a = 0, b; a < n; a = b) {
+    for (b = a + 1; b < n && t[b].key == t[a].key && t[b].k == t[a].k; b++) {
+      E[t[a].i].c += E[t[b].i].c;
+      E[t[b].i].key = INT32_MIN;            /* merged away */
+    }
+  }
+  size_t m = 0;
+  for (size_t i = 0; i < n; i++)
+    if (E[i].key != INT32_MIN)
+      E[m++] = E[i];
+  f->n = m;
+  free(t);
+  return 0;
+}
+
+static dm_expr finish_sum(dm_expr_ctx *ctx, dm_flat *f);
+
 /* sa*a + sb*b (b may be DM_EXPR_NONE: sa*a). */
 static dm_expr norm_sum(dm_expr_ctx *ctx, dm_expr a, int sa, dm_expr b, int sb)
 {
@@ -250,9 +323,45 @@ static dm_expr norm_sum(dm_expr_ctx *ctx, dm_expr a, int sa, dm_expr b, int sb)
   if (la > NORM_LIMIT || lb > NORM_LIMIT)
     return long_sum(ctx, a, b, sb, la, lb);
   dm_flat f = { 0, 0, 0, 1, 0 };
+  int lin = la + lb <= 16;              /* short: merge by linear search */
   if (flatten_sum(ctx, &f, a, sa, 0, 0) ||
-      (b != DM_EXPR_NONE && flatten_sum(ctx, &f, b, sb, 1, 1)))
+      (b != DM_EXPR_NONE && flatten_sum(ctx, &f, b, sb, 1, lin)) ||
+      (!lin && merge_like(ctx, &f)))
     return oom(ctx);
+  return finish_sum(ctx, &f);
+}
+
+dm_expr dm_expr__sum_n(dm_expr_ctx *ctx, size_t k, const dm_expr *t)
+{
+  size_t tot = 0;
+  for (size_t i = 0; i < k; i++) {
+    if (!check2(ctx, t[i], t[i]))
+      return DM_EXPR_NONE;
+    tot += nlen(ctx, t[i], 0);
+  }
+  if (k == 0)
+    return K(0.0);
+  if (k == 1)
+    return t[0];
+  if (tot > NORM_LIMIT) {               /* long: extended without collecting */
+    dm_expr r = t[0];
+    for (size_t i = 1; i < k && r != DM_EXPR_NONE; i++)
+      r = dm_expr_add(ctx, r, t[i]);
+    return r;
+  }
+  dm_flat f = { 0, 0, 0, 1, 0 };
+  for (size_t i = 0; i < k; i++)
+    if (flatten_sum(ctx, &f, t[i], 1, i == 0 ? 0 : 1, 0))
+      return oom(ctx);
+  if (merge_like(ctx, &f))
+    return oom(ctx);
+  return finish_sum(ctx, &f);
+}
+
+/* The normal sum of the element list f (ctx->nel[0]). */
+static dm_expr finish_sum(dm_expr_ctx *ctx, dm_flat *pf)
+{
+  dm_flat f = *pf;
   /* a collected term c*(sum) with c = +-1 is that sum's terms; a common
    * coefficient of every term (no constant) goes out: 0.5*x + 0.5*y ->
    * 0.5*(x + y) */
@@ -260,20 +369,26 @@ static dm_expr norm_sum(dm_expr_ctx *ctx, dm_expr a, int sa, dm_expr b, int sb)
   size_t n, k;
   double gamma = 1;
   for (;;) {
+    int expanded = 0, lin = f.n <= 16;
     for (size_t i = 0; i < f.n; i++) {
       dm_nel x = ctx->nel[0][i];
       if (x.k == DM_NE_PLAIN && (x.c == 1 || x.c == -1) && sumlike(ctx, x.key)) {
         ctx->nel[0][i].c = 0;
-        if (flatten_sum(ctx, &f, x.key, x.c > 0 ? 1 : -1, x.src, 1))
+        expanded = 1;
+        if (flatten_sum(ctx, &f, x.key, x.c > 0 ? 1 : -1, x.src, lin))
           return oom(ctx);
       }
     }
+    if (expanded && !lin && merge_like(ctx, &f))
+      return oom(ctx);
     E = ctx->nel[0];
     n = 0;
     for (size_t i = 0; i < f.n; i++)           /* drop t - t */
       if (E[i].c != 0)
         E[n++] = E[i];
     f.n = n;
+    if (expanded)                  /* the first operand's terms first again */
+      stable_by_src(ctx, n);
     k = split_at(E, n);
     if ((f.hasc && f.c != 0) || n < 2)
       break;
