@@ -150,10 +150,32 @@ int dm_expr_jacobian(dm_expr_ctx *ctx, size_t m, const dm_expr *f, size_t n,
 /* H[i*n + j] = d2 e / d vars_i d vars_j; the upper triangle is derived and
  * mirrored.  Rows are gradients of the gradient entries, by reverse sweeps
  * that stop at preaccumulated shared subexpressions, or by forward
- * differentiation -- both are built and the one with fewer operations is
- * kept. */
+ * differentiation -- both are built (the second only when affordable: it
+ * costs the size of a row's DAG per variable) and the one with fewer
+ * operations is kept. */
 int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
                     dm_expr *H, dm_err *err);
+/* Sparse derivatives.  Row i of a dm_expr_sparse holds the entries k in
+ * [rowptr[i], rowptr[i+1]): column col[k] (ascending), expression val[k];
+ * entries whose derivative is the constant 0 are left out (the structural
+ * pattern as the simplifier sees it). */
+typedef struct dm_expr_sparse {
+  size_t nrow, ncol, nnz;
+  size_t *rowptr;           /* nrow + 1 */
+  uint32_t *col;            /* nnz */
+  dm_expr *val;             /* nnz */
+} dm_expr_sparse;
+void dm_expr_sparse_free(dm_expr_sparse *s);   /* zeroes *s; NULL: no-op */
+/* The upper triangle (col >= row) of the Hessian of e, the same expressions
+ * as dm_expr_hessian, at a cost proportional to the size of the DAG of the
+ * gradient (plus the entries), not to n times it; the variables must be
+ * distinct (DM_EINVAL).  On error *H is zeroed. */
+int dm_expr_hessian_sparse(dm_expr_ctx *ctx, dm_expr e, size_t n,
+                           const dm_expr *vars, dm_expr_sparse *H, dm_err *err);
+/* J(i, j) = d f_i / d vars_j on its pattern, one reverse sweep per row. */
+int dm_expr_jacobian_sparse(dm_expr_ctx *ctx, size_t m, const dm_expr *f,
+                            size_t n, const dm_expr *vars, dm_expr_sparse *J,
+                            dm_err *err);
 /* sum_i (d e / d vars_i) dir_i. */
 dm_expr dm_expr_dirderiv(dm_expr_ctx *ctx, dm_expr e, size_t n,
                          const dm_expr *vars, const dm_expr *dir);

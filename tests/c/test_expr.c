@@ -90,6 +90,68 @@ static void test_hessians(void)
          "(max rel diff %.2g)", asym);
 }
 
+/* Sparse Hessians: the same expressions as the dense ones, on exactly the
+ * entries that are not the constant 0; sparse Jacobians: the dense ones'
+ * values there (the dense rows may come from the derivative memo, built
+ * another way); a variable listed twice is refused. */
+static void test_sparse_derivs(void)
+{
+  int bad = 0, same = 1;
+  dm_expr zero = dm_expr_const(C, 0.0);
+  for (size_t i = 0; i < NEXPR; i++) {
+    dm_expr e = tx_parse(C, exprs[i]), H[NV * NV], g[NV], J[NV * NV];
+    dm_expr_sparse S, SJ;
+    bad |= dm_expr_hessian(C, e, NV, V, H, NULL) != DM_OK;
+    bad |= dm_expr_hessian_sparse(C, e, NV, V, &S, NULL) != DM_OK;
+    bad |= dm_expr_grad(C, e, NV, V, g, NULL) != DM_OK;
+    bad |= dm_expr_jacobian(C, NV, g, NV, V, J, NULL) != DM_OK;
+    bad |= dm_expr_jacobian_sparse(C, NV, g, NV, V, &SJ, NULL) != DM_OK;
+    if (bad)
+      break;
+    size_t k = 0, kj = 0;
+    for (size_t a = 0; a < NV; a++)
+      for (size_t b = 0; b < NV; b++) {
+        if (b >= a && H[a * NV + b] != zero) {
+          same &= k < S.rowptr[a + 1] && S.col[k] == b && S.val[k] == H[a * NV + b];
+          k++;
+        }
+        if (J[a * NV + b] != zero) {
+          same &= kj < SJ.rowptr[a + 1] && SJ.col[kj] == b &&
+                  relerr(ev(SJ.val[kj]), ev(J[a * NV + b])) < 1e-14;
+          kj++;
+        }
+      }
+    same &= k == S.nnz && kj == SJ.nnz && S.nrow == NV && SJ.nrow == NV;
+    dm_expr_sparse_free(&S);
+    dm_expr_sparse_free(&SJ);
+  }
+  tap_ok(!bad && same, "sparse Hessians and Jacobians of %zu expressions: the dense ones' "
+         "nonzero entries", NEXPR);
+  dm_expr_sparse S;
+  dm_err err;
+  dm_expr dup[3] = { V[0], V[1], V[0] };
+  tap_is_int(dm_expr_hessian_sparse(C, tx_parse(C, "x*y"), 3, dup, &S, &err), DM_EINVAL,
+             "sparse Hessian: a variable listed twice (%s)", err.msg);
+  dm_expr_sparse_free(&S);
+  dm_expr_sparse_free(NULL);
+  /* a chain of 300 variables: the Hessian of sum (x_i - x_{i-1})^4 is
+   * tridiagonal, 2*300 - 1 entries in the upper triangle */
+  enum { NC = 300 };
+  dm_expr xs[NC], L = zero;
+  char nm[16];
+  for (int i = 0; i < NC; i++) {
+    snprintf(nm, sizeof nm, "c%d", i);
+    xs[i] = dm_expr_sym(C, nm);
+    if (i > 0)
+      L = dm_expr_add(C, L, dm_expr_powi(C, dm_expr_sub(C, xs[i], xs[i - 1]), 4));
+  }
+  int st = dm_expr_hessian_sparse(C, L, NC, xs, &S, NULL);
+  tap_ok(st == DM_OK && S.nnz == 2 * NC - 1 && S.rowptr[NC] == S.nnz && S.col[1] == 1 &&
+         S.col[2] == 1 && S.col[3] == 2, "chain of %d: tridiagonal pattern (%zu entries)",
+         NC, S.nnz);
+  dm_expr_sparse_free(&S);
+}
+
 /* Printing: a printed expression parses back to the same value. */
 static void test_print_roundtrip(void)
 {
@@ -367,6 +429,7 @@ int main(void)
                                                     : dm_expr_sym(C, names[i]);
   test_gradients();
   test_hessians();
+  test_sparse_derivs();
   test_print_roundtrip();
   test_printed_forms();
   test_identities();
