@@ -10,7 +10,9 @@
  * Conventions
  *  - n coordinates, m constraints, npar parameters.  Matrices are dense,
  *    row-major, n*n doubles: Lvv[i*n+j] = d2L/dv_i dv_j,
- *    Lvq[i*n+j] = d2L/dv_i dq_j, Lqq[i*n+j] = d2L/dq_i dq_j.
+ *    Lvq[i*n+j] = d2L/dv_i dq_j, Lqq[i*n+j] = d2L/dq_i dq_j -- or, when
+ *    the system has a pattern and the request says DM_LAG_SPARSE
+ *    (DM_FORCE_SPARSE), the values on that pattern.
  *  - Callbacks follow SUNDIALS: return 0 on success, > 0 for a recoverable
  *    failure (the point is outside the domain, e.g. sqrt of a negative number;
  *    a caller may retry with a smaller step), < 0 for an unrecoverable one.
@@ -29,6 +31,8 @@
 
 #include <stddef.h>
 
+#include "core/sparse.h"
+
 /* Which outputs a Lagrangian evaluation must fill (bit mask). */
 enum dm_lag_what {
   DM_LAG_L   = 1u << 0,   /* out->L                     */
@@ -38,7 +42,11 @@ enum dm_lag_what {
   DM_LAG_VQ  = 1u << 4,   /* out->Lvq[n*n]              */
   DM_LAG_QQ  = 1u << 5,   /* out->Lqq[n*n]              */
   DM_LAG_GRAD = DM_LAG_L | DM_LAG_Q | DM_LAG_V,
-  DM_LAG_ALL  = 0x3f
+  DM_LAG_ALL  = 0x3f,
+  /* with VV, VQ, QQ: those arrays hold the values on the system's pattern
+   * (sys->pattern->vv, vq, qq: vv.nnz, vq.nnz, qq.nnz doubles) instead of
+   * n*n dense matrices; only for systems with a pattern */
+  DM_LAG_SPARSE = 1u << 6
 };
 
 /* Output record; the caller points the arrays at storage it owns.  Only the
@@ -55,7 +63,8 @@ typedef int (*dm_lag_fn)(void *data, const double *q, const double *v,
 
 /* Generalized force F(q, v) (n) and its Jacobians Fq[i*n+j] = dF_i/dq_j,
  * Fv[i*n+j] = dF_i/dv_j; `what` uses DM_FORCE_* bits. */
-enum { DM_FORCE_F = 1u, DM_FORCE_Q = 2u, DM_FORCE_V = 4u };
+enum { DM_FORCE_F = 1u, DM_FORCE_Q = 2u, DM_FORCE_V = 4u,
+       DM_FORCE_SPARSE = 8u };     /* Fq, Fv as values on pattern->fq, fv */
 typedef int (*dm_force_fn)(void *data, const double *q, const double *v,
                            const double *par, unsigned what, double *F,
                            double *Fq, double *Fv, void *work);
@@ -80,6 +89,18 @@ enum dm_system_flags {
  * (integrator.h).  NULL means DM_SYSTEM_LAGRANGIAN. */
 #define DM_SYSTEM_LAGRANGIAN "lagrangian"   /* L(q, v) on R^n (coordinates) */
 
+/* The structural nonzeros of the second derivatives, for solvers that
+ * work on sparse matrices.  Full patterns (both triangles of the
+ * symmetric Lvv and Lqq); vq is Lvq's ([i][j] = d2L/dv_i dq_j); fq, fv
+ * are empty (nnz 0) for an unforced system.  mass: for a separable system
+ * the mass matrix as values on vv at the current parameters, else NULL.
+ * Owned by the system's filler. */
+typedef struct dm_sys_pattern {
+  dm_csr vv, vq, qq;
+  dm_csr fq, fv;
+  const double *mass;
+} dm_sys_pattern;
+
 typedef struct dm_system {
   const char *name;
   const char *kind;             /* static string; NULL: DM_SYSTEM_LAGRANGIAN */
@@ -90,7 +111,10 @@ typedef struct dm_system {
   const char *const *params;    /* npar names, may be NULL */
   double *par;                  /* npar current values */
   unsigned flags;               /* dm_system_flags */
-  const double *mass;           /* n*n, only with DM_SYS_SEPARABLE */
+  const double *mass;           /* n*n, only with DM_SYS_SEPARABLE; may be
+                                   NULL then for a large system whose
+                                   pattern holds a diagonal mass */
+  const dm_sys_pattern *pattern;  /* NULL: no pattern known (dense) */
 
   dm_lag_fn lagrangian;         /* required */
   dm_force_fn force;            /* NULL: unforced */

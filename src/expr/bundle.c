@@ -30,6 +30,11 @@ static dm_native_map *make_outmap(const dm_block *blk, size_t nblk, size_t nout,
       } else if (B->kind == DM_BLK_FULL) {
         for (size_t i = 0; i < n * n && k < nout; i++, k++)
           m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + (uint32_t)i };
+      } else if (B->kind == DM_BLK_PAIRS) {
+        for (size_t i = 0; i < n && k < nout; i++, k++)
+          for (int h = 0; h < 2; h++)
+            if (B->pos[2 * i + h] != DM_BLK_NOPOS)
+              m[j++] = (dm_native_map){ (uint32_t)k, B->arr, off + B->pos[2 * i + h] };
       } else {
         for (size_t i = 0; i < n; i++)
           for (size_t c = i; c < n && k < nout; c++, k++) {
@@ -106,13 +111,18 @@ int dm_bundle_compile(dm_bundle *p, const dm_bundle_src *src, size_t nout, const
     return dm_err_set(err, DM_ENOMEM, "out of memory");
   }
   p->nchk = 0;
-  for (size_t k = 0; k < nout; k++) {
-    int dup = oreg[k] >= c0 && oreg[k] < c1;
-    for (uint32_t j = 0; j < p->nchk && !dup; j++)
-      dup = p->chk[j] == oreg[k];
-    if (!dup)
-      p->chk[p->nchk++] = oreg[k];
+  uint8_t *seen = calloc(p->nregs + 1, 1);
+  if (seen == NULL) {
+    free(inmap);
+    free(outmap);
+    return dm_err_set(err, DM_ENOMEM, "out of memory");
   }
+  for (size_t k = 0; k < nout; k++)
+    if (!(oreg[k] >= c0 && oreg[k] < c1) && !seen[oreg[k]]) {
+      seen[oreg[k]] = 1;
+      p->chk[p->nchk++] = oreg[k];
+    }
+  free(seen);
   if (src->native == DM_NATIVE_NEVER) {
     free(inmap);
     free(outmap);

@@ -37,12 +37,17 @@
 #include "core/status.h"
 #include "expr/tape.h"
 
-/* Where outputs go. */
-enum { DM_BLK_VEC, DM_BLK_FULL, DM_BLK_SYM };
+/* Where outputs go.  DM_BLK_PAIRS: len outputs, output i stored at
+ * elements pos[2i] and pos[2i+1] of the array (the second DM_BLK_NOPOS for
+ * one place only): values on a sparse pattern, the upper triangle of a
+ * symmetric one written to both halves. */
+enum { DM_BLK_VEC, DM_BLK_FULL, DM_BLK_SYM, DM_BLK_PAIRS };
+#define DM_BLK_NOPOS UINT32_MAX
 typedef struct dm_block {
   unsigned arr, kind;       /* array index (< 32), DM_BLK_* */
   size_t len;               /* vector length or matrix order */
   size_t rep, stride;       /* repetitions, at this stride (constraint Hessians) */
+  const uint32_t *pos;      /* DM_BLK_PAIRS: 2 len places */
 } dm_block;
 
 /* What the bundles of one owner are compiled from. */

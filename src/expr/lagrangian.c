@@ -2,8 +2,7 @@
  * callbacks that run the tapes (or their native versions).  See
  * lagrangian.h. */
 #include <config.h>
-#include "expr/lagrangian.h"
-#include "expr/bundle.h"
+#include "expr/lagrangian_impl.h"
 #include "expr/tape.h"
 
 #include <float.h>
@@ -14,20 +13,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_linalg.h>
 
-typedef struct lag_data {
-  size_t n, m, npar;
-  char *name;
-  char **coords, **params;
-  double *par, *mass;
-  /* compiled bundles of outputs (bundle.h) */
-  dm_bundle grad, all;        /* L, Lq, Lv | + Lvv, Lvq, Lqq */
-  dm_bundle lq, qvqq;         /* separable L: Lq (of q alone) | Lq, Lv, Lqq */
-  const dm_bundle *sel[DM_LAG_ALL + 1];  /* the cheapest bundle for each request */
-  dm_bundle force, force_all; /* F | + Fq, Fv */
-  dm_bundle constr, constr_all;  /* g, G | + H */
-  dm_bundle massp;            /* Lvv (n*n) when constant in q and v */
-  int mass_possible;
-} lag_data;
+typedef lag_builder builder;
 
 static void lag_free_data(lag_data *d)
 {
@@ -42,6 +28,10 @@ static void lag_free_data(lag_data *d)
   free(d->name);
   free(d->par);
   free(d->mass);
+  free(d->pmass);
+  dm_csr *pp[] = { &d->pat.vv, &d->pat.vq, &d->pat.qq, &d->pat.fq, &d->pat.fv };
+  for (size_t i = 0; i < sizeof pp / sizeof pp[0]; i++)
+    dm_csr_free(pp[i]);
   dm_bundle *ps[] = { &d->grad, &d->all, &d->lq, &d->qvqq, &d->force, &d->force_all,
                       &d->constr, &d->constr_all, &d->massp };
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
@@ -81,23 +71,78 @@ static int nonfinite(const double *x, size_t k)
 /* The request mask is passed with L (whose storage is always there) and
  * the arrays the bundle lacks (p->fill) set, so that a request of all the
  * bundle has takes native code's direct path. */
-static int lag_eval(void *data, const double *q, const double *v,
-                    const double *par, unsigned what, dm_lag_out *out,
-                    void *work)
+static int lag_run(const lag_data *d, const double *q, const double *v,
+                   const double *par, unsigned what, dm_lag_out *out, double *w)
 {
-  const lag_data *d = data;
   const size_t n = d->n;
   const dm_bundle *p = d->sel[what & DM_LAG_ALL];
   double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    return p->scatter(in, par, o, what | DM_LAG_L | p->fill);
+    return p->scatter(in, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill);
   }
-  double *w = work;
   copy(w, q, n);
   if (p->nin > n)
     copy(w + n, v, n);
-  return dm_bundle_tape_scatter(p, w, par, o, what | DM_LAG_L | p->fill);
+  return dm_bundle_tape_scatter(p, w, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill);
+}
+
+/* Second derivatives asked for in the other layout than the bundles have:
+ * computed into the scratch after the tapes' work, then spread (values ->
+ * dense, zeros elsewhere) or gathered (dense -> values). */
+static int lag_convert(const lag_data *d, const double *q, const double *v,
+                       const double *par, unsigned what, dm_lag_out *out, double *w)
+{
+  const dm_csr *pat[3] = { &d->pat.vv, &d->pat.vq, &d->pat.qq };
+  double **dst[3] = { &out->Lvv, &out->Lvq, &out->Lqq };
+  const unsigned bit[3] = { DM_LAG_VV, DM_LAG_VQ, DM_LAG_QQ };
+  dm_lag_out t = *out;
+  double **tp[3] = { &t.Lvv, &t.Lvq, &t.Lqq };
+  double *s = w + d->need;
+  for (int b = 0; b < 3; b++) {
+    *tp[b] = s;
+    s += d->sparse ? pat[b]->nnz : d->n * d->n;
+  }
+  int st = lag_run(d, q, v, par, what, &t, w);
+  out->L = t.L;
+  if (st != 0)
+    return st;
+  for (int b = 0; b < 3; b++)
+    if (what & bit[b]) {
+      if (d->sparse)
+        dm_csr_to_dense(pat[b], *tp[b], *dst[b]);
+      else
+        dm_csr_from_dense(pat[b], *tp[b], *dst[b]);
+    }
+  return 0;
+}
+
+static int lag_eval(void *data, const double *q, const double *v,
+                    const double *par, unsigned what, dm_lag_out *out,
+                    void *work)
+{
+  const lag_data *d = data;
+  int sp = (what & DM_LAG_SPARSE) != 0;
+  if ((what & (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ)) && sp != d->sparse)
+    return lag_convert(d, q, v, par, what, out, work);
+  return lag_run(d, q, v, par, what, out, work);
+}
+
+static int force_run(const lag_data *d, const double *q, const double *v,
+                     const double *par, unsigned what, double *F, double *Fq,
+                     double *Fv, double *w)
+{
+  const size_t n = d->n;
+  const dm_bundle *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
+  double *o[3] = { F, Fq, Fv };
+  what &= DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V;
+  if (p->scatter != NULL) {
+    const double *in[2] = { q, v };
+    return p->scatter(in, par, o, what);
+  }
+  copy(w, q, n);
+  copy(w + n, v, n);
+  return dm_bundle_tape_scatter(p, w, par, o, what);
 }
 
 static int force_eval(void *data, const double *q, const double *v,
@@ -105,17 +150,27 @@ static int force_eval(void *data, const double *q, const double *v,
                       double *Fv, void *work)
 {
   const lag_data *d = data;
-  const size_t n = d->n;
-  const dm_bundle *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
-  double *o[3] = { F, Fq, Fv };
-  if (p->scatter != NULL) {
-    const double *in[2] = { q, v };
-    return p->scatter(in, par, o, what);
+  int sp = (what & DM_FORCE_SPARSE) != 0;
+  if (!(what & (DM_FORCE_Q | DM_FORCE_V)) || sp == d->sparse)
+    return force_run(d, q, v, par, what, F, Fq, Fv, work);
+  const dm_csr *pat[2] = { &d->pat.fq, &d->pat.fv };
+  double *dst[2] = { Fq, Fv }, *tp[2];
+  double *s = (double *)work + d->need;
+  for (int b = 0; b < 2; b++) {
+    tp[b] = s;
+    s += d->sparse ? pat[b]->nnz : d->n * d->n;
   }
-  double *w = work;
-  copy(w, q, n);
-  copy(w + n, v, n);
-  return dm_bundle_tape_scatter(p, w, par, o, what);
+  int st = force_run(d, q, v, par, what, F, tp[0], tp[1], work);
+  if (st != 0)
+    return st;
+  for (int b = 0; b < 2; b++)
+    if (what & (b == 0 ? DM_FORCE_Q : DM_FORCE_V)) {
+      if (d->sparse)
+        dm_csr_to_dense(pat[b], tp[b], dst[b]);
+      else
+        dm_csr_from_dense(pat[b], tp[b], dst[b]);
+    }
+  return 0;
 }
 
 static int constr_eval(void *data, const double *q, const double *par,
@@ -138,14 +193,6 @@ static int constr_eval(void *data, const double *q, const double *par,
  * building
  * =================================================================== */
 
-typedef struct builder {
-  dm_expr_ctx *ctx;
-  const dm_lagrangian_spec *sp;
-  dm_expr *in;              /* q then v */
-  double *in0;              /* typical inputs, or NULL */
-  dm_err *err;
-} builder;
-
 static int ctx_fail(builder *b, const char *what)
 {
   const dm_err *e = dm_expr_ctx_err(b->ctx);
@@ -157,39 +204,63 @@ static int ctx_fail(builder *b, const char *what)
  * its scattering function for the blocks) when the mode asks for it.
  * exact: out was rewritten by dm_tape_optimize already (so that bundles
  * sharing outputs compute them identically). */
-static int compile_bundle(builder *b, dm_bundle *p, size_t nout, const dm_expr *out,
-                        size_t nin, const dm_block *blk, size_t nblk, int exact)
+int dm_lag__compile_bundle(lag_builder *b, dm_bundle *p, size_t nout, const dm_expr *out,
+                           size_t nin, const dm_block *blk, size_t nblk, int exact)
 {
   const dm_lagrangian_spec *sp = b->sp;
   dm_bundle_src src = { b->ctx, b->in, sp->n, sp->npar, sp->par, b->in0,
                         sp->par_values, sp->native };
   return dm_bundle_compile(p, &src, nout, out, nin, blk, nblk, exact, b->err);
 }
+#define compile_bundle dm_lag__compile_bundle
 
-/* Every symbol or parameter in e must be one of allowed[0..na). */
-static int check_vars(builder *b, dm_expr e, const char *what, size_t na,
-                      const dm_expr *allowed, const dm_expr *vel)
+static int cmp_expr(const void *a, const void *b)
 {
-  dm_expr fv[64];
-  long k = dm_expr_free_vars(b->ctx, e, fv, 64);
+  dm_expr x = *(const dm_expr *)a, y = *(const dm_expr *)b;
+  return (x > y) - (x < y);
+}
+
+static int cmp_pair(const void *a, const void *b)
+{
+  const dm_expr *x = a, *y = b;
+  if (x[0] != y[0])
+    return (x[0] > y[0]) - (x[0] < y[0]);
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+static int member(dm_expr x, size_t n, const dm_expr *sorted)
+{
+  return n > 0 && bsearch(&x, sorted, n, sizeof x, cmp_expr) != NULL;
+}
+
+/* Every symbol or parameter in e must be one of allowed[0..na) (sorted);
+ * vel (sorted, nv, may be NULL) names the velocities for the message. */
+static int check_vars(builder *b, dm_expr e, const char *what, size_t na,
+                      const dm_expr *allowed, size_t nv, const dm_expr *vel)
+{
+  dm_expr fv1[64], *fv = fv1;
+  long k = dm_expr_free_vars(b->ctx, e, NULL, 0);
   if (k < 0)
     return dm_err_set(b->err, DM_EINVAL, "%s is not a valid expression", what);
-  for (long i = 0; i < k && i < 64; i++) {
-    int ok = 0;
-    for (size_t j = 0; j < na && !ok; j++)
-      ok = allowed[j] == fv[i];
-    if (ok)
+  if (k > 64 && (fv = malloc((size_t)k * sizeof *fv)) == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  dm_expr_free_vars(b->ctx, e, fv, (size_t)k);
+  int s = DM_OK;
+  for (long i = 0; i < k && s == DM_OK; i++) {
+    if (member(fv[i], na, allowed))
       continue;
-    for (size_t j = 0; vel != NULL && j < b->sp->n; j++)
-      if (vel[j] == fv[i])
-        return dm_err_set(b->err, DM_EINVAL, "%s depends on the velocity "
-                          "'%s'", what, dm_expr_name(b->ctx, fv[i]));
-    return dm_err_set(b->err, DM_EINVAL, "%s depends on %s '%s', which is "
-                      "not a coordinate, velocity or parameter", what,
-                      dm_expr_kind(b->ctx, fv[i]) == DM_EXPR_SYM ? "symbol"
-                      : "parameter", dm_expr_name(b->ctx, fv[i]));
+    if (vel != NULL && member(fv[i], nv, vel))
+      s = dm_err_set(b->err, DM_EINVAL, "%s depends on the velocity "
+                     "'%s'", what, dm_expr_name(b->ctx, fv[i]));
+    else
+      s = dm_err_set(b->err, DM_EINVAL, "%s depends on %s '%s', which is "
+                     "not a coordinate, velocity or parameter", what,
+                     dm_expr_kind(b->ctx, fv[i]) == DM_EXPR_SYM ? "symbol"
+                     : "parameter", dm_expr_name(b->ctx, fv[i]));
   }
-  return DM_OK;
+  if (fv != fv1)
+    free(fv);
+  return s;
 }
 
 static char *dupstr(const char *s)
@@ -220,47 +291,68 @@ static int copy_names(lag_data *d, const dm_lagrangian_spec *sp,
   return 0;
 }
 
-/* Evaluate the mass matrix at the current parameters and test positive
- * definiteness (Cholesky).  Returns 1 when M is SPD. */
+/* Evaluate the mass matrix at the current parameters into pmass (values
+ * on pat.vv) and, for n <= DM_LAG_MASS_DENSE_MAX, mass (dense), and test
+ * positive definiteness: a diagonal mass by its entries, another one by a
+ * dense Cholesky factorisation when it has a dense copy.  Returns 1 when M
+ * is SPD. */
 static int eval_mass(lag_data *d)
 {
-  size_t n = d->n, nw = d->massp.nregs;
-  double *buf = calloc(nw + 2 * n * n + 1, sizeof *buf);
+  size_t n = d->n, nw = d->massp.nregs, nnz = d->pat.vv.nnz;
+  double *buf = calloc(nw + d->massp.nout + (d->mass ? n * n : 0) + 1, sizeof *buf);
   if (buf == NULL)
     return 0;
   const double *M0 = dm_bundle_run_plain(&d->massp, buf, d->par);  /* q = v = 0 */
-  memcpy(d->mass, M0, n * n * sizeof *buf);
-  double *A = buf + nw + n * n;
-  memcpy(A, M0, n * n * sizeof *buf);
-  gsl_matrix_view M = gsl_matrix_view_array(A, n, n);
-  int spd = !nonfinite(d->mass, n * n) &&   /* needs dm_gsl_init() */
-            gsl_linalg_cholesky_decomp1(&M.matrix) == GSL_SUCCESS;
+  if (d->sparse) {
+    memcpy(d->pmass, M0, nnz * sizeof *buf);
+    if (d->mass)
+      dm_csr_to_dense(&d->pat.vv, d->pmass, d->mass);
+  } else {
+    memcpy(d->mass, M0, n * n * sizeof *buf);
+    dm_csr_from_dense(&d->pat.vv, d->mass, d->pmass);
+  }
+  int diag = 1, spd;
+  for (size_t i = 0; i < n && diag; i++)
+    diag = d->pat.vv.rowptr[i + 1] == d->pat.vv.rowptr[i] + 1 &&
+           d->pat.vv.col[d->pat.vv.rowptr[i]] == i;
+  if (diag) {
+    spd = !nonfinite(d->pmass, nnz);
+    for (size_t i = 0; i < n && spd; i++)
+      spd = d->pmass[i] > 0.0;
+  } else if (d->mass != NULL) {
+    double *A = buf + nw + d->massp.nout;
+    memcpy(A, d->mass, n * n * sizeof *buf);
+    gsl_matrix_view M = gsl_matrix_view_array(A, n, n);
+    spd = !nonfinite(d->mass, n * n) &&   /* needs dm_gsl_init() */
+          gsl_linalg_cholesky_decomp1(&M.matrix) == GSL_SUCCESS;
+  } else {
+    spd = 0;
+  }
   free(buf);
   return spd;
 }
 
-/* Structure flags from the derived expressions; may compile the mass. */
-static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
-                            const dm_expr *Lvv, const dm_expr *Lvq,
-                            unsigned *flags)
+/* Structure flags from the derived expressions (nvv entries of Lvv, each
+ * once); may compile the mass bundle, whose outputs mout are the mass in
+ * the layout's order (dense n*n, or on pat.vv). */
+int dm_lag__detect_structure(lag_builder *b, lag_data *d, const dm_expr *Lv,
+                             size_t nvv, const dm_expr *Lvv, int lvq_zero,
+                             size_t nmout, const dm_expr *mout, unsigned *flags)
 {
   const dm_lagrangian_spec *sp = b->sp;
   size_t n = sp->n;
   int mech = 1, constant = 1;
-  for (size_t i = 0; i < n * n; i++) {
+  for (size_t i = 0; i < nvv; i++) {
     mech &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->v);
     constant &= !dm_expr_depends(b->ctx, Lvv[i], n, sp->q);
   }
   *flags = mech ? DM_SYS_MECHANICAL : 0;
-  if (!mech || !constant)
+  if (!mech || !constant || !lvq_zero)
     return DM_OK;
-  double c;
-  for (size_t i = 0; i < n * n; i++)
-    if (!dm_expr_is_const(b->ctx, Lvq[i], &c) || c != 0)
-      return DM_OK;
   /* Lv(q, 0) == 0: no term linear in v */
   dm_expr *zero = malloc(n * sizeof *zero), *Lv0 = malloc(n * sizeof *Lv0);
   int s = DM_ENOMEM, ok = 0;
+  double c;
   if (zero && Lv0) {
     for (size_t i = 0; i < n; i++)
       zero[i] = dm_expr_const(b->ctx, 0.0);
@@ -275,14 +367,15 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
     return s;
   if (!ok)
     return DM_OK;
-  d->mass = malloc(n * n * sizeof *d->mass);
-  if (d->mass == NULL)
+  if (n <= DM_LAG_MASS_DENSE_MAX && (d->mass = malloc(n * n * sizeof *d->mass)) == NULL)
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  if ((d->pmass = malloc((d->pat.vv.nnz + 1) * sizeof *d->pmass)) == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   builder nb = *b;
   dm_lagrangian_spec tsp = *sp;
   tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
   nb.sp = &tsp;
-  s = compile_bundle(&nb, &d->massp, n * n, Lvv, 2 * n, NULL, 0, 0);
+  s = compile_bundle(&nb, &d->massp, nmout, mout, 2 * n, NULL, 0, 0);
   if (s != DM_OK)
     return s;
   d->mass_possible = 1;
@@ -296,7 +389,7 @@ static int detect_structure(builder *b, lag_data *d, const dm_expr *Lv,
  * asked for, four times that when the bundle runs on the tape (native
  * code, where it compiled, always wins over a tape; with auto a bundle
  * whose compilation failed falls back to its tape alone). */
-static void select_progs(lag_data *d)
+void dm_lag__select(lag_data *d)
 {
   const dm_bundle *ps[] = { &d->lq, &d->qvqq, &d->grad, &d->all };
   for (unsigned w = 0; w <= DM_LAG_ALL; w++) {
@@ -348,7 +441,37 @@ int dm_lagrangian_outputs(dm_expr_ctx *ctx, dm_expr L, size_t n, const dm_expr *
   return dm_tape_optimize(ctx, 1 + 2 * n + 2 * tri + n * n, out, ow, err);
 }
 
-/* L and its derivatives: tapes grad and all, and the structure flags. */
+/* Patterns of the dense layout from its outputs: Lvv and Lqq upper
+ * triangles (tri entries each), Lvq full; an entry is in the pattern
+ * unless it is the constant 0. */
+static int dense_patterns(dm_expr_ctx *ctx, lag_data *d, const dm_expr *o)
+{
+  size_t n = d->n, tri = n * (n + 1) / 2, ne;
+  uint32_t *r = malloc((n * n + 1) * sizeof *r), *c = malloc((n * n + 1) * sizeof *c);
+  uint32_t *pos = malloc((2 * n * n + 1) * sizeof *pos);
+  dm_csr *pat[3] = { &d->pat.vv, &d->pat.vq, &d->pat.qq };
+  const dm_expr *blk[3] = { o, o + tri, o + tri + n * n };
+  int s = r && c && pos ? DM_OK : DM_ENOMEM;
+  double z;
+  for (int k = 0; k < 3 && s == DM_OK; k++) {
+    size_t e = 0;
+    ne = 0;
+    for (size_t i = 0; i < n; i++)
+      for (size_t j = k == 1 ? 0 : i; j < n; j++, e++)
+        if (!dm_expr_is_const(ctx, blk[k][e], &z) || z != 0) {
+          r[ne] = (uint32_t)i;
+          c[ne++] = (uint32_t)j;
+        }
+    s = dm_lag__pattern(pat[k], n, ne, r, c, k != 1, pos);
+  }
+  free(r);
+  free(c);
+  free(pos);
+  return s;
+}
+
+/* L and its derivatives, dense layout: tapes grad and all, the structure
+ * flags, the patterns. */
 static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
 {
   const dm_lagrangian_spec *sp = b->sp;
@@ -365,31 +488,36 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
    * Hessian are computed the same way, bit for bit */
   if ((s = dm_lagrangian_outputs(b->ctx, sp->L, n, b->in, out, ow, b->err)) != DM_OK)
     goto done;
-  const dm_expr *Lv = out + 1 + n, *Lvq = out + 1 + 2 * n + tri;
+  if ((s = dense_patterns(b->ctx, d, out + 1 + 2 * n)) != DM_OK) {
+    dm_err_set(b->err, s, "out of memory");
+    goto done;
+  }
+  const dm_expr *Lv = out + 1 + n;
   for (size_t i = 0, k = 1 + 2 * n; i < n; i++)
     for (size_t j = i; j < n; j++, k++)
       Lvv[i * n + j] = Lvv[j * n + i] = out[k];
-  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0 }, { 1, DM_BLK_VEC, n, 1, 0 },
-                           { 2, DM_BLK_VEC, n, 1, 0 }, { 3, DM_BLK_SYM, n, 1, 0 },
-                           { 4, DM_BLK_FULL, n, 1, 0 }, { 5, DM_BLK_SYM, n, 1, 0 } };
+  const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0, NULL }, { 1, DM_BLK_VEC, n, 1, 0, NULL },
+                           { 2, DM_BLK_VEC, n, 1, 0, NULL }, { 3, DM_BLK_SYM, n, 1, 0, NULL },
+                           { 4, DM_BLK_FULL, n, 1, 0, NULL }, { 5, DM_BLK_SYM, n, 1, 0, NULL } };
   if ((s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
       (s = compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = detect_structure(b, d, Lv, Lvv, Lvq, flags)) != DM_OK)
+      (s = dm_lag__detect_structure(b, d, Lv, n * n, Lvv, d->pat.vq.nnz == 0, n * n, Lvv,
+                                    flags)) != DM_OK)
     goto done;
   if (d->mass_possible) {
     /* separable (Lvq = 0, Lvv constant): Lq depends on q alone, and the
      * integrators ask for Lq alone (Stormer-Verlet) or for Lq, Lv, Lqq
      * (the Newton matrix, Lvv being the mass); both bundles from the same
      * rewritten outputs, so their values are those of grad and all */
-    const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0 } };
-    const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0 }, { 2, DM_BLK_VEC, n, 1, 0 },
-                             { 5, DM_BLK_SYM, n, 1, 0 } };
+    const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0, NULL } };
+    const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0, NULL }, { 2, DM_BLK_VEC, n, 1, 0, NULL },
+                             { 5, DM_BLK_SYM, n, 1, 0, NULL } };
     memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
     if ((s = compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
         (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
       goto done;
   }
-  select_progs(d);
+  dm_lag__select(d);
 done:
   free(out);
   free(ow);
@@ -415,16 +543,47 @@ static int build_force(builder *b, lag_data *d)
   const dm_lagrangian_spec *sp = b->sp;
   size_t n = sp->n, nall = n + 2 * n * n;
   dm_expr *out = malloc(nall * sizeof *out);
-  if (out == NULL)
+  uint32_t *r = malloc((n * n + 1) * sizeof *r), *c = malloc((n * n + 1) * sizeof *c);
+  uint32_t *pos = malloc((2 * n * n + 1) * sizeof *pos);
+  if (out == NULL || r == NULL || c == NULL || pos == NULL) {
+    free(out);
+    free(r);
+    free(c);
+    free(pos);
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
-  const dm_block blk[] = { { 0, DM_BLK_VEC, n, 1, 0 }, { 1, DM_BLK_FULL, n, 1, 0 },
-                           { 2, DM_BLK_FULL, n, 1, 0 } };
+  }
+  const dm_block blk[] = { { 0, DM_BLK_VEC, n, 1, 0, NULL }, { 1, DM_BLK_FULL, n, 1, 0, NULL },
+                           { 2, DM_BLK_FULL, n, 1, 0, NULL } };
   int s = dm_lagrangian_force_outputs(b->ctx, n, sp->force, b->in, out, b->err);
+  /* the patterns from the Jacobians before rewriting */
+  dm_expr *J = malloc((2 * n * n + 1) * sizeof *J);
+  if (s == DM_OK && J != NULL &&
+      dm_expr_jacobian(b->ctx, n, sp->force, n, b->in, J, NULL) == DM_OK &&
+      dm_expr_jacobian(b->ctx, n, sp->force, n, b->in + n, J + n * n, NULL) == DM_OK) {
+    dm_csr *pat[2] = { &d->pat.fq, &d->pat.fv };
+    double z;
+    for (int k = 0; k < 2 && s == DM_OK; k++) {
+      size_t ne = 0;
+      for (size_t i = 0; i < n * n; i++)
+        if (!dm_expr_is_const(b->ctx, J[k * n * n + i], &z) || z != 0) {
+          r[ne] = (uint32_t)(i / n);
+          c[ne++] = (uint32_t)(i % n);
+        }
+      if (dm_lag__pattern(pat[k], n, ne, r, c, 0, pos) != DM_OK)
+        s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
+    }
+  } else if (s == DM_OK) {
+    s = ctx_fail(b, "force");
+  }
+  free(J);
   if (s == DM_OK)
     s = compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
   if (s == DM_OK)
     s = compile_bundle(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
   free(out);
+  free(r);
+  free(c);
+  free(pos);
   return s;
 }
 
@@ -437,8 +596,9 @@ static int build_constraints(builder *b, lag_data *d)
   if (out == NULL)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
   memcpy(out, sp->constraints, m * sizeof *out);
-  const dm_block blk[] = { { 0, DM_BLK_VEC, m, 1, 0 }, { 1, DM_BLK_VEC, m * n, 1, 0 },
-                           { 2, DM_BLK_SYM, n, m, n * n } };
+  const dm_block blk[] = { { 0, DM_BLK_VEC, m, 1, 0, NULL },
+                           { 1, DM_BLK_VEC, m * n, 1, 0, NULL },
+                           { 2, DM_BLK_SYM, n, m, n * n, NULL } };
   dm_expr *G = out + m, *o = out + m + m * n;
   int s = DM_OK;
   if (dm_expr_jacobian(b->ctx, m, sp->constraints, n, sp->q, G, NULL) != DM_OK)
@@ -459,6 +619,27 @@ static int build_constraints(builder *b, lag_data *d)
   return s;
 }
 
+/* The smallest i such that x[i] is among x[0..i), -1 if none, -2 out of
+ * memory. */
+static long first_repeat(const dm_expr *x, size_t n)
+{
+  dm_expr (*t)[2] = malloc((n ? n : 1) * sizeof *t);
+  if (t == NULL)
+    return -2;
+  for (size_t i = 0; i < n; i++) {
+    t[i][0] = x[i];
+    t[i][1] = (dm_expr)i;
+  }
+  qsort(t, n, sizeof *t, cmp_pair);
+  long best = -1;
+  for (size_t i = 1; i < n; i++)       /* within a group, indices ascend */
+    if (t[i][0] == t[i - 1][0] && (i < 2 || t[i - 2][0] != t[i][0]) &&
+        (best < 0 || t[i][1] < best))
+      best = t[i][1];
+  free(t);
+  return best;
+}
+
 static int check_spec(builder *b)
 {
   const dm_lagrangian_spec *sp = b->sp;
@@ -472,30 +653,40 @@ static int check_spec(builder *b)
     if (dm_expr_kind(b->ctx, b->in[i]) != DM_EXPR_SYM)
       return dm_err_set(b->err, DM_EINVAL, "%s %zu is not a symbol",
                         i < n ? "coordinate" : "velocity", i % n + 1);
-  for (size_t i = 0; i < 2 * n; i++)
-    for (size_t j = 0; j < i; j++)
-      if (b->in[i] == b->in[j])
-        return dm_err_set(b->err, DM_EINVAL, "'%s' is listed twice among the "
-                          "coordinates and velocities",
-                          dm_expr_name(b->ctx, b->in[i]));
-  dm_expr *allowed = malloc(na * sizeof *allowed);
-  if (allowed == NULL)
+  long dup = first_repeat(b->in, 2 * n);
+  if (dup == -2)
     return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  if (dup >= 0)
+    return dm_err_set(b->err, DM_EINVAL, "'%s' is listed twice among the "
+                      "coordinates and velocities", dm_expr_name(b->ctx, b->in[dup]));
+  dm_expr *allowed = malloc(na * sizeof *allowed), *vel = malloc(n * sizeof *vel);
+  if (allowed == NULL || vel == NULL) {
+    free(allowed);
+    free(vel);
+    return dm_err_set(b->err, DM_ENOMEM, "out of memory");
+  }
   memcpy(allowed, b->in, 2 * n * sizeof *allowed);
   if (sp->npar)
     memcpy(allowed + 2 * n, sp->par, sp->npar * sizeof *allowed);
-  int s = check_vars(b, sp->L, "L", na, allowed, NULL);
+  qsort(allowed, na, sizeof *allowed, cmp_expr);
+  int s = check_vars(b, sp->L, "L", na, allowed, 0, NULL);
   for (size_t i = 0; s == DM_OK && sp->force && i < n; i++) {
     snprintf(what, sizeof what, "force component %zu", i + 1);
-    s = check_vars(b, sp->force[i], what, na, allowed, NULL);
+    s = check_vars(b, sp->force[i], what, na, allowed, 0, NULL);
   }
   /* constraints: coordinates and parameters only */
-  memmove(allowed + n, allowed + 2 * n, sp->npar * sizeof *allowed);
+  memcpy(allowed, sp->q, n * sizeof *allowed);
+  if (sp->npar)
+    memcpy(allowed + n, sp->par, sp->npar * sizeof *allowed);
+  qsort(allowed, n + sp->npar, sizeof *allowed, cmp_expr);
+  memcpy(vel, sp->v, n * sizeof *vel);
+  qsort(vel, n, sizeof *vel, cmp_expr);
   for (size_t a = 0; s == DM_OK && a < sp->m; a++) {
     snprintf(what, sizeof what, "constraint %zu", a + 1);
-    s = check_vars(b, sp->constraints[a], what, n + sp->npar, allowed, sp->v);
+    s = check_vars(b, sp->constraints[a], what, n + sp->npar, allowed, n, vel);
   }
   free(allowed);
+  free(vel);
   return s;
 }
 
@@ -537,8 +728,11 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
     goto fail;
   }
   unsigned flags = 0;
-  if ((s = build_lagrangian(&b, d, &flags)) != DM_OK ||
-      (sp->force && (s = build_force(&b, d)) != DM_OK) ||
+  d->sparse = sp->layout == DM_LAG_LAYOUT_SPARSE ||
+              (sp->layout != DM_LAG_LAYOUT_DENSE && n > DM_LAG_DENSE_MAX);
+  if ((s = (d->sparse ? dm_lag__build_sparse : build_lagrangian)(&b, d, &flags)) != DM_OK ||
+      (sp->force && (s = (d->sparse ? dm_lag__build_force_sparse : build_force)(&b, d))
+       != DM_OK) ||
       (sp->m && (s = build_constraints(&b, d)) != DM_OK))
     goto fail;
 
@@ -548,6 +742,11 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
   for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++)
     if (bundle_need(ps[i]) > need)
       need = bundle_need(ps[i]);
+  d->need = need;
+  /* scratch for second derivatives asked for in the other layout */
+  size_t conv = d->sparse ? d->pat.vv.nnz + d->pat.vq.nnz + d->pat.qq.nnz : 3 * n * n;
+  size_t fconv = !sp->force ? 0 : d->sparse ? d->pat.fq.nnz + d->pat.fv.nnz : 2 * n * n;
+  need += conv > fconv ? conv : fconv;
   sys->name = d->name;
   sys->n = n;
   sys->npar = sp->npar;
@@ -557,6 +756,8 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
   sys->par = d->par;
   sys->flags = flags;
   sys->mass = (flags & DM_SYS_SEPARABLE) ? d->mass : NULL;
+  d->pat.mass = (flags & DM_SYS_SEPARABLE) ? d->pmass : NULL;
+  sys->pattern = &d->pat;
   sys->lagrangian = lag_eval;
   sys->force = sp->force ? force_eval : NULL;
   sys->constraints = sp->m ? constr_eval : NULL;
@@ -584,9 +785,11 @@ int dm_lagrangian_refresh(dm_system *sys, dm_err *err)
   if (eval_mass(d)) {
     sys->flags |= DM_SYS_SEPARABLE;
     sys->mass = d->mass;
+    d->pat.mass = d->pmass;
   } else {
     sys->flags &= ~(unsigned)DM_SYS_SEPARABLE;
     sys->mass = NULL;
+    d->pat.mass = NULL;
   }
   return DM_OK;
 }
@@ -608,5 +811,6 @@ int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st)
   st->ninstr_sep = d->qvqq.tape ? dm_tape_ninstr(d->qvqq.tape) : 0;
   st->native_q = d->lq.fn != NULL;
   st->native_sep = d->qvqq.fn != NULL;
+  st->sparse = d->sparse;
   return DM_OK;
 }

@@ -15,6 +15,15 @@
  * them.  On the tape path the outputs are laid out in the tape's slots as
  * in the caller's arrays, which are then copied whole.
  *
+ * Every system gets the structural patterns of its second derivatives
+ * (sys->pattern, system.h); with more than 32 coordinates (or layout
+ * DM_LAG_LAYOUT_SPARSE) the Hessian is derived on its pattern only and the
+ * bundles compute values on the patterns (dense requests are spread into
+ * the caller's n x n arrays, zeros elsewhere); a separable system then has
+ * sys->mass only up to 256 coordinates (pattern->mass always), and needs a
+ * diagonal mass above that.  Constraint derivatives are always dense
+ * (m n^2 doubles for the second ones).
+ *
  * Structure detected symbolically:
  *  - DM_SYS_MECHANICAL when no entry of Lvv contains a velocity (L is
  *    quadratic in v);
@@ -65,7 +74,13 @@ typedef struct dm_lagrangian_spec {
   int native;                   /* enum dm_native_mode */
   const double *q0, *v0;        /* a typical state for checking native
                                    code (may be NULL) */
+  int layout;                   /* enum dm_lag_layout */
 } dm_lagrangian_spec;
+
+/* How the second derivatives are compiled: dense n x n arrays, or values
+ * on their structural patterns (sys->pattern; the other layout is served
+ * by spreading or gathering).  Auto: dense up to 32 coordinates. */
+enum dm_lag_layout { DM_LAG_LAYOUT_AUTO = 0, DM_LAG_LAYOUT_DENSE, DM_LAG_LAYOUT_SPARSE };
 
 int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *spec,
                           dm_system *sys, dm_err *err);
@@ -99,6 +114,7 @@ typedef struct dm_lagrangian_stats {
    * Lq, Lv, Lqq; 0 when not built */
   size_t ninstr_q, ninstr_sep;
   int native_q, native_sep;
+  int sparse;                         /* 1: the sparse layout */
 } dm_lagrangian_stats;
 
 int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st);

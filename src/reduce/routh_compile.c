@@ -84,7 +84,7 @@ static int compile_stage(dm_bundle *p, const dm_bundle_src *src, const dm_expr *
     size_t len = kind == DM_BLK_VEC ? s : kind == DM_BLK_FULL ? s * s : s * (s + 1) / 2;
     if (from[k] == NULL)
       continue;
-    blk[nb++] = (dm_block){(unsigned)k, kind, s, 1, 0};
+    blk[nb++] = (dm_block){(unsigned)k, kind, s, 1, 0, NULL};
     memcpy(o, from[k], len * sizeof *o);
     o += len;
   }
