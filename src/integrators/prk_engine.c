@@ -21,9 +21,9 @@
  * q and p increments are added with Kahan compensation; the carries persist
  * while steps continue from the previous output.
  *
- * The discrete Legendre transforms solve the boundary problem: unknowns V and
- * p0 with sum_j b_j V_j = (q1 - q0)/h; then p1 = p0 + h sum b_j W_j and
- * Ld = h sum b_i L(Q_i, V_i) (Suris; thesis Thm 2.12).
+ * The discrete Legendre transforms (p0, p1, Ld for given q0, q1) are the
+ * Galerkin discrete Lagrangian of the same tableau: galerkin.h, the one
+ * solver of that boundary problem (the discrete Routh equations use it too).
  *
  * The Jacobian of the step map comes from the implicit function theorem on
  * R(V; q0, p0) = 0 at the converged stages:
@@ -43,11 +43,7 @@
 
 static size_t nunk(const dm_prk *P, int mode)
 {
-  switch (mode) {
-  case DM_PRK_CSTEP: return P->sn + P->nK * P->m + P->m;
-  case DM_PRK_DLEG: return P->sn + P->n;
-  default: return P->sn;
-  }
+  return mode == DM_PRK_CSTEP ? P->sn + P->nK * P->m + P->m : P->sn;
 }
 
 int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
@@ -82,7 +78,7 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
     free(P);
     return st;
   }
-  extra = P->nK * m + m > n ? P->nK * m + m : n;
+  extra = P->nK * m + m;
   P->Nmax = sn + extra;
   tot = P->Nmax * P->Nmax + 3 * P->Nmax + 5 * sn + 7 * s * nn + s
         + (s + 2) * (m + m * n + m * nn) + 6 * n + P->Nmax * 2 * n
@@ -91,6 +87,12 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
   P->perm = calloc(P->Nmax, sizeof(size_t));
   P->work = sys->work_size ? malloc(sys->work_size) : NULL;
   P->leg = dm_legendre_alloc(sys);
+  if (m == 0 && (st = dm_galerkin_alloc(sys, t, tol, maxiter, &P->gal, e)) != DM_OK) {
+    free(d);
+    P->Jm = NULL;
+    dm_prk_free(P);
+    return st;
+  }
   if (d == NULL || P->perm == NULL || (sys->work_size && P->work == NULL) || P->leg == NULL) {
     free(d);
     P->Jm = NULL;
@@ -134,6 +136,7 @@ void dm_prk_free(dm_prk *P)
   free(P->perm);
   free(P->work);
   dm_legendre_free(P->leg);
+  dm_galerkin_free(P->gal);
   dm_tableau_free(P->tab);
   free(P);
 }
@@ -152,8 +155,8 @@ int dm_prk_is_explicit(const dm_prk *P)
   return P->explicit_sv;
 }
 
-/* Evaluate L (and the force) at stage i: gradients always, second
- * derivatives when jac; W, D, Bm derived. */
+/* Evaluate L (and the force) at stage i: gradients always, the value when
+ * want_L, second derivatives when jac; W, D, Bm derived. */
 int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
 {
   size_t n = P->n, nn = P->nn, a, b;
@@ -236,12 +239,12 @@ static void newton_matrix(dm_prk *P, double h, size_t N)
 }
 
 /* Residual (and Newton matrix when jac) of the stage equations at X. */
-static int assemble(dm_prk *P, int mode, double h, const double *q0, const double *p0,
-                    const double *q1t, int jac, dm_err *e)
+static int assemble(dm_prk *P, int mode, double h, const double *q0, const double *p0, int jac,
+                    dm_err *e)
 {
   const size_t n = P->n, s = P->s, sn = P->sn, N = nunk(P, mode);
-  const double *A = P->tab->a, *At = P->tab->at, *b = P->tab->b;
-  const double *V = P->X, *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
+  const double *A = P->tab->a, *At = P->tab->at;
+  const double *V = P->X, *pp = p0;
   size_t i, j, a;
   int st;
   {
@@ -255,7 +258,7 @@ static int assemble(dm_prk *P, int mode, double h, const double *q0, const doubl
       }
   }
   for (i = 0; i < s; i++)
-    if ((st = dm_prk_eval_stage(P, i, jac, mode == DM_PRK_DLEG, e)) != DM_OK)
+    if ((st = dm_prk_eval_stage(P, i, jac, 0, e)) != DM_OK)
       return st;
   {
     const double *restrict W = P->W, *restrict Lv = P->Lv;
@@ -267,25 +270,12 @@ static int assemble(dm_prk *P, int mode, double h, const double *q0, const doubl
           acc += At[i * s + j] * W[j * n + a];
         R[i * n + a] = Lv[i * n + a] - pp[a] - h * acc;
       }
-    if (mode == DM_PRK_DLEG)
-      for (a = 0; a < n; a++) {
-        double acc = 0.0;
-        for (j = 0; j < s; j++)
-          acc += b[j] * V[j * n + a];
-        R[sn + a] = acc - (q1t[a] - q0[a]) / h;
-      }
   }
   if (jac) {
     if (N > sn)
       memset(P->Jm, 0, N * N * sizeof(double));
     newton_matrix(P, h, N);
     P->lvv_norm = dm_norm_inf(P->Lvv, s * P->nn);
-    if (mode == DM_PRK_DLEG)
-      for (i = 0; i < s; i++)
-        for (a = 0; a < n; a++) {
-          P->Jm[(i * n + a) * N + sn + a] = -1.0;
-          P->Jm[(sn + a) * N + i * n + a] = b[i];
-        }
   }
   if (mode == DM_PRK_CSTEP)
     return dm_prk_constr_assemble(P, h, q0, jac, e);
@@ -301,8 +291,7 @@ static double update_norm(const dm_prk *P, int mode, double h, const double *p0,
                           double xv)
 {
   size_t sn = P->sn, N = nunk(P, mode);
-  const double *pp = mode == DM_PRK_DLEG ? P->X + sn : p0;
-  double ms = dm_norm_inf(pp, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
+  double ms = dm_norm_inf(p0, P->n) + fabs(h) * dm_norm_inf(P->W, sn);
   double lv = P->lvv_norm;      /* Lvv changes only with the Jacobian */
   double vs = dm_max3(xv, lv > 0 ? ms / lv : 0.0, DBL_MIN);
   double d = rv / vs;
@@ -333,14 +322,14 @@ int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
 }
 
 static int newton(dm_prk *P, int mode, double h, const double *q0, const double *p0,
-                  const double *q1t, dm_integ_stats *stt, dm_err *e)
+                  dm_integ_stats *stt, dm_err *e)
 {
   size_t N = nunk(P, mode), i;
   double d = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
   int it, st, ok = 0, jac = 1, njac = 0;
   for (it = 1; it <= P->maxiter; it++) {
-    if ((st = assemble(P, mode, h, q0, p0, q1t, jac, e)) != DM_OK)
+    if ((st = assemble(P, mode, h, q0, p0, jac, e)) != DM_OK)
       return st;
     rn = dm_norm_inf(P->R, N);
     if (!isfinite(rn))
@@ -403,9 +392,9 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
                       it, d, P->tol, rn, h);
   /* The stage forces were evaluated before the last update; when that update
    * is at round-off they are the converged ones, otherwise evaluate again. */
-  if (d <= 1e-12 && mode != DM_PRK_DLEG)
+  if (d <= 1e-12)
     return DM_OK;
-  return assemble(P, mode, h, q0, p0, q1t, 0, e);
+  return assemble(P, mode, h, q0, p0, 0, e);
 }
 
 static int predict(dm_prk *P, double h, const double *q0, const double *p0, int cont,
@@ -459,7 +448,7 @@ int dm_prk_step(dm_prk *P, double h, const double *q0, const double *p0,
     if (st == DM_OK && P->m)
       st = dm_prk_constr_begin(P, q0, e);
     if (st == DM_OK)
-      st = newton(P, mode, h, q0, p0, NULL, stt, e);
+      st = newton(P, mode, h, q0, p0, stt, e);
     if (st == DM_OK && P->m) {
       st = dm_prk_constr_finish(P, h, q0, p0, P->q1w, P->p1w, e);
     } else if (st == DM_OK) {
@@ -518,7 +507,7 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
     return dm_err_set(e, DM_EUNSUP, "the step Jacobian is not available for constrained systems");
   if ((st = dm_prk_step(P, h, q0, p0, DPhi, DPhi + n, stt, e)) != DM_OK)
     return st;
-  if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, NULL, 1, e)) != DM_OK)
+  if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, 1, e)) != DM_OK)
     return st;
   if (dm_smalllu_factor(P->Jm, sn, P->perm) != DM_OK)
     return dm_prk_singular(P, "stage equations", h, e);
@@ -574,33 +563,16 @@ int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e)
 int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
                      double *p0, double *p1, double *Ld, dm_integ_stats *stt, dm_err *e)
 {
-  size_t n = P->n, s = P->s, sn = P->sn, i, a;
-  const double *b = P->tab->b;
   int st = dm_prk_dleg_check(P, h, e);
   if (st != DM_OK)
     return st;
-  for (i = 0; i < s; i++)
-    for (a = 0; a < n; a++)
-      P->X[i * n + a] = (q1[a] - q0[a]) / h;
-  memset(P->X + sn, 0, n * sizeof(double));
-  if ((st = newton(P, DM_PRK_DLEG, h, q0, NULL, q1, stt, e)) != DM_OK)
-    return st;
-  if (Ld) {
-    *Ld = 0.0;
-    for (i = 0; i < s; i++)
-      *Ld += h * b[i] * P->Lval[i];
+  st = dm_galerkin_solve(P->gal, h, q0, q1, Ld, p0, p1, NULL, NULL, NULL, NULL, 0, e);
+  if (stt) {
+    stt->iters = dm_galerkin_iters(P->gal);
+    stt->jacs = stt->iters;
+    stt->iters_total += stt->iters;
   }
-  for (a = 0; a < n; a++) {
-    double acc = 0.0;
-    for (i = 0; i < s; i++)
-      acc += b[i] * P->W[i * n + a];
-    P->tmp[a] = P->X[sn + a] + h * acc;
-  }
-  if (p0)
-    memcpy(p0, P->X + sn, n * sizeof(double));
-  if (p1)
-    memcpy(p1, P->tmp, n * sizeof(double));
-  return DM_OK;
+  return st;
 }
 
 /* {==== type-object glue for the PRK families ============================ */

@@ -5,11 +5,11 @@
 #define DM_PRK_IMPL_H
 
 #include "integrators/integ_impl.h"
+#include "integrators/galerkin.h"
 
 enum dm_prk_mode {
   DM_PRK_STEP,      /* unknowns: stage velocities V (s n) */
-  DM_PRK_CSTEP,     /* V, stage multipliers (nK m), initial multiplier mu0 (m) */
-  DM_PRK_DLEG       /* V, p0 (n): boundary problem for given (q0, q1) */
+  DM_PRK_CSTEP      /* V, stage multipliers (nK m), initial multiplier mu0 (m) */
 };
 
 /* Structure of a constant mass matrix (explicit Stormer-Verlet). */
@@ -54,6 +54,7 @@ struct dm_prk {
   double *svf;                 /* Lq at hq1 (first same as last) */
   int svf_valid;
   dm_legendre_ws *leg;
+  dm_galerkin *gal;            /* discrete Legendre transforms (m == 0; else NULL) */
   void *work;
 };
 

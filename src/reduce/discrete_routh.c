@@ -4,7 +4,7 @@
  *   psi_mu(x0, x1): J_d((0, x0), (psi, x1)) = mu, J_d = D2 L_d along theta;
  *     midpoint: psi = h I(xbar)^{-1} mu - A(xbar)(x1 - x0) (linear, no
  *     iteration); Galerkin: Newton on p1_theta = mu with the exact
- *     d p1_theta / d theta1 from the boundary problem (galerkin_ld.c);
+ *     d p1_theta / d theta1 from the boundary problem (integrators/galerkin.h);
  *   Lhat(x0, x1) = L_d((0, x0), (psi, x1));
  *   D1 Lhat = dL_d/dx0 + mu . D1 psi,   D2 Lhat = dL_d/dx1 + mu . D2 psi,
  *   Ahat_1 = mu . D1 psi - muA(x0),     Ahat_2 = mu . D2 psi + muA(x1);
@@ -26,7 +26,7 @@
 struct dm_routh_dr {
   dm_routh *red;
   const dm_system *fsys;
-  dm_gld *g;                       /* NULL: midpoint closed form */
+  dm_galerkin *g;                  /* NULL: midpoint closed form */
   size_t n, r, d;
   double tol;
   int maxiter, iters;
@@ -45,7 +45,7 @@ void dm_routh_dr_free(dm_routh_dr *dr)
 {
   if (dr == NULL)
     return;
-  dm_gld_free(dr->g);
+  dm_galerkin_free(dr->g);
   dm_rlu_free(&dr->lu_d);
   dm_rlu_free(&dr->lu_r);
   free(dr->q0);
@@ -107,14 +107,14 @@ int dm_routh_dr_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxite
   if (t == NULL && red->general) {   /* no closed-form psi: midpoint = Galerkin-Gauss 1 */
     dm_tableau *g1 = NULL;
     if ((st = dm_tableau_gauss(1, &g1, e)) == DM_OK)
-      st = dm_gld_alloc(&red->fsys, g1, dr->tol, dr->maxiter, &dr->g, e);
+      st = dm_galerkin_alloc(&red->fsys, g1, dr->tol, dr->maxiter, &dr->g, e);
     dm_tableau_free(g1);
     if (st != DM_OK) {
       dm_routh_dr_free(dr);
       return st;
     }
   }
-  if (t != NULL && (st = dm_gld_alloc(&red->fsys, t, dr->tol, dr->maxiter, &dr->g, e)) != DM_OK) {
+  if (t != NULL && (st = dm_galerkin_alloc(&red->fsys, t, dr->tol, dr->maxiter, &dr->g, e)) != DM_OK) {
     dm_routh_dr_free(dr);
     return st;
   }
@@ -243,8 +243,8 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
   dm_routh_join(red, NULL, x0, dr->q0);
   for (it = 0; it < (size_t)dr->maxiter; it++) {
     dm_routh_join(red, dr->psi, x1, dr->q1);
-    st = dm_gld_solve(dr->g, h, dr->q0, dr->q1, dr->p0, dr->p1, dr->Ld, 1, dr->d00, dr->d01,
-                      dr->d10, dr->d11, 1, e);
+    st = dm_galerkin_solve(dr->g, h, dr->q0, dr->q1, dr->Ld, dr->p0, dr->p1, dr->d00, dr->d01,
+                           dr->d10, dr->d11, 1, e);
     if (st != DM_OK)
       return st;
     for (a = 0; a < r; a++) {
@@ -267,8 +267,8 @@ static int lift_galerkin(dm_routh_dr *dr, double h, const double *x0, const doub
   if (!ok)
     return dm_err_set(e, DM_ENOCONV, "psi_mu: Newton on J_d = mu did not converge (update %.3g)", dn);
   dm_routh_join(red, dr->psi, x1, dr->q1);
-  st = dm_gld_solve(dr->g, h, dr->q0, dr->q1, dr->p0, dr->p1, dr->Ld, deriv, dr->d00, dr->d01,
-                    dr->d10, dr->d11, 1, e);
+  st = dm_galerkin_solve(dr->g, h, dr->q0, dr->q1, dr->Ld, dr->p0, dr->p1,
+                         deriv ? dr->d00 : NULL, dr->d01, dr->d10, dr->d11, 1, e);
   if (st != DM_OK || !deriv)
     return st;
   /* Dpsi: d11_tt D2psi = -d11_tx, d11_tt D1psi = -d10_tx (q0 = (0, x0)) */

@@ -6,6 +6,7 @@
 #include "reduce/routh.h"
 #include "expr/bundle.h"
 #include "core/newton.h"
+#include "integrators/galerkin.h"
 #include "expr/tape.h"
 
 /* A compiled bundle of outputs: tape, and native code when available. */
@@ -164,21 +165,6 @@ void dm_rlu_solve(const dm_rlu *lu, const double *a, size_t N, double *rhs);
 
 double dm_rnorm_inf(const double *x, size_t n);
 const char *dm_rfmt_vec(char *buf, size_t len, const double *x, size_t n);
-
-/* Galerkin discrete Lagrangian of a (full, unconstrained, unforced) system:
- * boundary problem for (V, p0) given (q0, q1); derivatives of p0, p1 with
- * respect to q0 and q1 by implicit differentiation (galerkin_ld.c). */
-typedef struct dm_gld dm_gld;
-int dm_gld_alloc(const dm_system *sys, const dm_tableau *t, double tol, int maxiter,
-                 dm_gld **out, dm_err *e);
-void dm_gld_free(dm_gld *g);
-/* p0 = -D1 Ld, p1 = D2 Ld, Ld; with deriv != 0 also the n x n blocks
- * dp0/dq0, dp0/dq1, dp1/dq0, dp1/dq1 (row-major, into d00, d01, d10, d11).
- * The stage velocities of the last solve seed the next one when warm != 0. */
-int dm_gld_solve(dm_gld *g, double h, const double *q0, const double *q1, double *p0,
-                 double *p1, double *Ld, int deriv, double *d00, double *d01, double *d10,
-                 double *d11, int warm, dm_err *e);
-int dm_gld_iters(const dm_gld *g);
 
 /* RSPRK engine (rsprk.c): the reduced symplectic PRK step of thesis eq.
  * 2.5.14 on T*S for any PRK tableau, constraints with Lobatto-type
