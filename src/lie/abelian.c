@@ -129,7 +129,8 @@ static void rn_act(const dm_lie_group *G, const double *g, const double *x, doub
 const dm_lie_type dm_lie_type_rn = {
   "Rn", DM_LIE_RN, ab_identity, ab_compose, ab_inverse, ab_copy, ab_copy,
   ab_Ad, ab_ad, ab_bracket, ab_dexp, ab_copy, rn_icay, ab_dexp, rn_hat, rn_vee,
-  rn_matrix, rn_from_matrix, rn_act, ab_normalize, ab_defect, ab_generator
+  rn_matrix, rn_from_matrix, rn_act, ab_normalize, ab_defect, ab_generator,
+  &dm_lie_sym_rn
 };
 
 /* }====================================================================== */
@@ -235,13 +236,15 @@ static void tn_act(const dm_lie_group *G, const double *g, const double *x, doub
 const dm_lie_type dm_lie_type_so2 = {
   "SO2", DM_LIE_SO2, ab_identity, ab_compose, ab_inverse, ab_copy, tn_log,
   ab_Ad, ab_ad, ab_bracket, ab_dexp, tn_cay, tn_icay, tn_dcay, tn_hat, tn_vee,
-  tn_matrix, tn_from_matrix, tn_act, ab_normalize, ab_defect, ab_generator
+  tn_matrix, tn_from_matrix, tn_act, ab_normalize, ab_defect, ab_generator,
+  &dm_lie_sym_tn
 };
 
 const dm_lie_type dm_lie_type_tn = {
   "Tn", DM_LIE_TN, ab_identity, ab_compose, ab_inverse, ab_copy, tn_log,
   ab_Ad, ab_ad, ab_bracket, ab_dexp, tn_cay, tn_icay, tn_dcay, tn_hat, tn_vee,
-  tn_matrix, tn_from_matrix, tn_act, ab_normalize, ab_defect, ab_generator
+  tn_matrix, tn_from_matrix, tn_act, ab_normalize, ab_defect, ab_generator,
+  &dm_lie_sym_tn
 };
 
 /* }====================================================================== */

@@ -50,6 +50,11 @@
  * only by round-off (a random walk, ~1e-13 after 1e7 compositions);
  * dm_lie_normalize projects back (polar factor by SVD).
  *
+ * Symbolic elements.  Every operation except normalization and checks
+ * also exists on expression nodes (dm_lie_sym_*, below), so that a
+ * Lagrangian written with group elements is traced into the expression
+ * engine and differentiated exactly, including at the identity.
+ *
  * Spheres.  S^n is the unit sphere in R^(n+1) (points: n+1 doubles);
  * dm_lie_sphere_* give its exponential, logarithm, distance and tangent
  * projection, and for S^2 the SO(3) action and the rotation carrying one
@@ -76,8 +81,10 @@
 #include <stddef.h>
 
 #include "core/status.h"
+#include "expr/expr.h"
 
 typedef struct dm_lie_group dm_lie_group;
+typedef struct dm_lie_sym_type dm_lie_sym_type;
 
 enum dm_lie_kind {
   DM_LIE_RN = 0, DM_LIE_SO2, DM_LIE_TN, DM_LIE_SO3, DM_LIE_SE2, DM_LIE_SE3,
@@ -126,6 +133,7 @@ typedef struct dm_lie_type {
   /* dg = d/de (g exp(e e_k)) (side LEFT) or d/de (exp(e e_k) g) (RIGHT),
    * in storage coordinates (nq) */
   void (*generator)(const dm_lie_group *G, const double *g, size_t k, int side, double *dg);
+  const dm_lie_sym_type *sym;   /* the same operations on expressions */
 } dm_lie_type;
 
 /* The descriptor.  Read the fields; never write them. */
@@ -224,6 +232,95 @@ void dm_lie_generator(const dm_lie_group *G, const double *g, size_t k, int side
  * coordinates: out_k = sum_a df/dg_a dg_a(k), dg from dm_lie_generator. */
 void dm_lie_trivialize(const dm_lie_group *G, const double *g, const double *grad,
                        int side, double *out);
+
+/* {==== symbolic elements ================================================
+ * The same operations on expression nodes (expr.h): an element is an array
+ * of G->nq nodes, an algebra element G->dim nodes, matrices row-major with
+ * no leading dimension (dim x dim, msize x msize).  The results are the
+ * numeric formulas as expressions, with the series branches as
+ * select(t < threshold, series, closed form) so that their values and
+ * every derivative are those of the numeric code; the logarithm takes the
+ * branches of the numeric one (atan2, the symmetric part beyond pi/2) with
+ * selects.  Normalization, checks and the matrix-to-element conversion
+ * are numeric only.  Inputs may be constants (numbers fold).
+ *
+ * Each function returns DM_OK, or the context's error (DM_ENOMEM, ...) with
+ * its message copied into e; the outputs are then unspecified.  Nodes
+ * belong to the context (expr.h); the functions allocate nothing else.
+ * Like the context, not thread safe. */
+
+struct dm_lie_sym_type {
+  void (*identity)(dm_expr_ctx *c, const dm_lie_group *G, dm_expr *g);
+  void (*compose)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *a,
+                  const dm_expr *b, dm_expr *ab);
+  void (*inverse)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *a, dm_expr *ai);
+  void (*exp)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *g);
+  void (*log)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *xi);
+  void (*Ad)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *M, size_t ld);
+  void (*ad)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *M, size_t ld);
+  void (*dexp)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int inv,
+               dm_expr *M, size_t ld);
+  void (*cay)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *g);
+  void (*icay)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *xi);
+  void (*dcay)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int inv,
+               dm_expr *M, size_t ld);
+  void (*hat)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *A, size_t ld);
+  void (*vee)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *A, size_t ld, dm_expr *xi);
+  void (*matrix)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *M,
+                 size_t ld);
+  void (*act)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, const dm_expr *x,
+              dm_expr *y);
+  void (*generator)(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, size_t k,
+                    int side, dm_expr *dg);
+};
+
+int dm_lie_sym_identity(dm_expr_ctx *c, const dm_lie_group *G, dm_expr *g, dm_err *e);
+int dm_lie_sym_compose(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *a,
+                       const dm_expr *b, dm_expr *ab, dm_err *e);
+int dm_lie_sym_inverse(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *a, dm_expr *ai,
+                       dm_err *e);
+int dm_lie_sym_exp(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *g,
+                   dm_err *e);
+int dm_lie_sym_log(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *xi,
+                   dm_err *e);
+int dm_lie_sym_Ad(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *M,
+                  dm_err *e);
+int dm_lie_sym_ad(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *M,
+                  dm_err *e);
+int dm_lie_sym_bracket(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *a,
+                       const dm_expr *b, dm_expr *ab, dm_err *e);
+/* y = M x for a dim x dim M (trans: M^T x) */
+int dm_lie_sym_matvec(dm_expr_ctx *c, size_t n, const dm_expr *M, int trans,
+                      const dm_expr *x, dm_expr *y, dm_err *e);
+int dm_lie_sym_dexp(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int side,
+                    dm_expr *M, dm_err *e);
+int dm_lie_sym_dexpinv(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int side,
+                       dm_expr *M, dm_err *e);
+int dm_lie_sym_cay(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *g,
+                   dm_err *e);
+/* the closed form (infinite or NaN on the cut locus) */
+int dm_lie_sym_icay(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *xi,
+                    dm_err *e);
+int dm_lie_sym_dcay(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int side,
+                    dm_expr *M, dm_err *e);
+int dm_lie_sym_dcayinv(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, int side,
+                       dm_expr *M, dm_err *e);
+int dm_lie_sym_hat(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *xi, dm_expr *A,
+                   dm_err *e);
+int dm_lie_sym_vee(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *A, dm_expr *xi,
+                   dm_err *e);
+int dm_lie_sym_matrix(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, dm_expr *M,
+                      dm_err *e);
+int dm_lie_sym_act(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, const dm_expr *x,
+                   dm_expr *y, dm_err *e);
+int dm_lie_sym_generator(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g, size_t k,
+                         int side, dm_expr *dg, dm_err *e);
+/* out_k = sum_a grad_a dg_a(k): the trivialized gradient of a function
+ * from its gradient in storage coordinates */
+int dm_lie_sym_trivialize(dm_expr_ctx *c, const dm_lie_group *G, const dm_expr *g,
+                          const dm_expr *grad, int side, dm_expr *out, dm_err *e);
+
+/* }====================================================================== */
 
 /* {==== the sphere S^n in R^(n+1) ========================================= */
 

@@ -26,102 +26,109 @@ static inline double dm_lie_horner(const double *c, int n, double t)
 }
 
 /* sin(th)/th */
+static const double dm_lie_ser_sinc[] = {1.0, -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880,
+                           -1.0 / 39916800};
+
 static inline double dm_lie_sinc(double t)
 {
-  static const double c[] = {1.0, -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880,
-                             -1.0 / 39916800};
   double th;
   if (t < 1e-2)
-    return dm_lie_horner(c, 6, t);
+    return dm_lie_horner(dm_lie_ser_sinc, 6, t);
   th = sqrt(t);
   return sin(th) / th;
 }
 
 /* (1 - cos th)/th^2 = 2 sin^2(th/2)/th^2 */
+static const double dm_lie_ser_cosc[] = {0.5, -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800,
+                           -1.0 / 479001600};
+
 static inline double dm_lie_cosc(double t)
 {
-  static const double c[] = {0.5, -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800,
-                             -1.0 / 479001600};
   double th, s;
   if (t < 1e-2)
-    return dm_lie_horner(c, 6, t);
+    return dm_lie_horner(dm_lie_ser_cosc, 6, t);
   th = sqrt(t);
   s = sin(0.5 * th) / th;
   return 2.0 * s * s;
 }
 
 /* (th - sin th)/th^3 */
+static const double dm_lie_ser_sinc3[] = {
+  0.16666666666666666, -0.0083333333333333332, 0.00019841269841269841,
+  -2.7557319223985893e-06, 2.505210838544172e-08, -1.6059043836821613e-10,
+  7.6471637318198164e-13, -2.8114572543455206e-15, 8.2206352466243295e-18,
+  -1.9572941063391263e-20, 3.8681701706306841e-23, -6.4469502843844736e-26,
+  9.183689863795546e-29, -1.1309962886447716e-31, 1.2161250415535179e-34};
+
 static inline double dm_lie_sinc3(double t)
 {
-  static const double c[] = {
-    0.16666666666666666, -0.0083333333333333332, 0.00019841269841269841,
-    -2.7557319223985893e-06, 2.505210838544172e-08, -1.6059043836821613e-10,
-    7.6471637318198164e-13, -2.8114572543455206e-15, 8.2206352466243295e-18,
-    -1.9572941063391263e-20, 3.8681701706306841e-23, -6.4469502843844736e-26,
-    9.183689863795546e-29, -1.1309962886447716e-31, 1.2161250415535179e-34};
   double th;
   if (t < 4.0)
-    return dm_lie_horner(c, 15, t);
+    return dm_lie_horner(dm_lie_ser_sinc3, 15, t);
   th = sqrt(t);
   return (th - sin(th)) / (t * th);
 }
 
 /* (1 - (th/2) cot(th/2))/th^2: the coefficient of hat(w)^2 in dexp^-1 of
  * SO(3) (finite at th = pi, singular at 2 pi) */
+static const double dm_lie_ser_dexpinv_coef[] = {
+  0.083333333333333329, 0.0013888888888888889, 3.3068783068783071e-05,
+  8.2671957671957675e-07, 2.08767569878681e-08, 5.2841901386874932e-10,
+  1.3382536530684679e-11, 3.3896802963225827e-13, 8.5860620562778452e-15,
+  2.1748686985580619e-16, 5.5090028283602295e-18, 1.3954464685812522e-19,
+  3.5347070396294673e-21, 8.9535174270375463e-23, 2.2679524523376829e-24,
+  5.7447906688722025e-26, 1.455172475614865e-27};
+
 static inline double dm_lie_dexpinv_coef(double t)
 {
-  static const double c[] = {
-    0.083333333333333329, 0.0013888888888888889, 3.3068783068783071e-05,
-    8.2671957671957675e-07, 2.08767569878681e-08, 5.2841901386874932e-10,
-    1.3382536530684679e-11, 3.3896802963225827e-13, 8.5860620562778452e-15,
-    2.1748686985580619e-16, 5.5090028283602295e-18, 1.3954464685812522e-19,
-    3.5347070396294673e-21, 8.9535174270375463e-23, 2.2679524523376829e-24,
-    5.7447906688722025e-26, 1.455172475614865e-27};
   double th;
   if (t < 4.0)
-    return dm_lie_horner(c, 17, t);
+    return dm_lie_horner(dm_lie_ser_dexpinv_coef, 17, t);
   th = sqrt(t);
   return (1.0 - 0.5 * th * cos(0.5 * th) / sin(0.5 * th)) / t;
 }
 
 /* (th^2/2 + cos th - 1)/th^4 */
+static const double dm_lie_ser_coefE[] = {
+  0.041666666666666664, -0.0013888888888888889, 2.4801587301587302e-05,
+  -2.7557319223985888e-07, 2.08767569878681e-09, -1.1470745597729725e-11,
+  4.7794773323873853e-14, -1.5619206968586225e-16, 4.1103176233121648e-19,
+  -8.8967913924505741e-22, 1.6117375710961184e-24, -2.4795962632247976e-27,
+  3.2798892370698378e-30, -3.7699876288159054e-33};
+
 static inline double dm_lie_coefE(double t)
 {
-  static const double c[] = {
-    0.041666666666666664, -0.0013888888888888889, 2.4801587301587302e-05,
-    -2.7557319223985888e-07, 2.08767569878681e-09, -1.1470745597729725e-11,
-    4.7794773323873853e-14, -1.5619206968586225e-16, 4.1103176233121648e-19,
-    -8.8967913924505741e-22, 1.6117375710961184e-24, -2.4795962632247976e-27,
-    3.2798892370698378e-30, -3.7699876288159054e-33};
   if (t < 4.0)
-    return dm_lie_horner(c, 14, t);
+    return dm_lie_horner(dm_lie_ser_coefE, 14, t);
   return (0.5 * t + cos(sqrt(t)) - 1.0) / (t * t);
 }
 
 /* (2 th - 3 sin th + th cos th)/(2 th^5) */
+static const double dm_lie_ser_coefG[] = {
+  0.0083333333333333332, -0.00039682539682539683, 8.2671957671957678e-06,
+  -1.0020843354176688e-07, 8.0295219184108074e-10, -4.5882982390918896e-12,
+  1.9680200780418645e-14, -6.5765081972994636e-17, 1.7615646957052136e-19,
+  -3.8681701706306839e-22, 7.0916453128229206e-25, -1.1020427836554655e-27,
+  1.4702951752382032e-30, -1.7025750581749252e-33};
+
 static inline double dm_lie_coefG(double t)
 {
-  static const double c[] = {
-    0.0083333333333333332, -0.00039682539682539683, 8.2671957671957678e-06,
-    -1.0020843354176688e-07, 8.0295219184108074e-10, -4.5882982390918896e-12,
-    1.9680200780418645e-14, -6.5765081972994636e-17, 1.7615646957052136e-19,
-    -3.8681701706306839e-22, 7.0916453128229206e-25, -1.1020427836554655e-27,
-    1.4702951752382032e-30, -1.7025750581749252e-33};
   double th;
   if (t < 4.0)
-    return dm_lie_horner(c, 14, t);
+    return dm_lie_horner(dm_lie_ser_coefG, 14, t);
   th = sqrt(t);
   return (2.0 * th - 3.0 * sin(th) + th * cos(th)) / (2.0 * t * t * th);
 }
 
 /* th/sin(th) for the logarithm (th in [0, pi/2] where it is used) */
+static const double dm_lie_ser_invsinc[] = {1.0, 1.0 / 6, 7.0 / 360, 31.0 / 15120, 127.0 / 604800,
+                           73.0 / 3421440};
+
 static inline double dm_lie_invsinc(double t)
 {
-  static const double c[] = {1.0, 1.0 / 6, 7.0 / 360, 31.0 / 15120, 127.0 / 604800,
-                             73.0 / 3421440};
   double th;
   if (t < 1e-2)
-    return dm_lie_horner(c, 6, t);
+    return dm_lie_horner(dm_lie_ser_invsinc, 6, t);
   th = sqrt(t);
   return th / sin(th);
 }
@@ -246,6 +253,8 @@ void dm_so3_log(const double *R, double *w);
 
 /* {==== family type objects and shared helpers =========================== */
 
+extern const dm_lie_sym_type dm_lie_sym_rn, dm_lie_sym_tn, dm_lie_sym_so3,
+  dm_lie_sym_se2, dm_lie_sym_se3, dm_lie_sym_product;
 extern const dm_lie_type dm_lie_type_rn, dm_lie_type_so2, dm_lie_type_tn,
   dm_lie_type_so3, dm_lie_type_se2, dm_lie_type_se3, dm_lie_type_product;
 

@@ -200,5 +200,5 @@ static void pr_generator(const dm_lie_group *G, const double *g, size_t k, int s
 const dm_lie_type dm_lie_type_product = {
   "product", DM_LIE_PRODUCT, pr_identity, pr_compose, pr_inverse, pr_exp, pr_log,
   pr_Ad, pr_ad, pr_bracket, pr_dexp, pr_cay, pr_icay, pr_dcay, pr_hat, pr_vee,
-  pr_matrix, pr_from_matrix, pr_act, pr_normalize, pr_defect, pr_generator
+  pr_matrix, pr_from_matrix, pr_act, pr_normalize, pr_defect, pr_generator, &dm_lie_sym_product
 };

@@ -215,5 +215,5 @@ const dm_lie_type dm_lie_type_se2 = {
   "SE2", DM_LIE_SE2, se2_identity, se2_compose, se2_inverse, se2_exp, se2_log,
   se2_Ad, se2_ad, se2_bracket, se2_dexp, se2_cay, se2_icay, se2_dcay, se2_hat,
   se2_vee, se2_matrix, se2_from_matrix, se2_act, se2_normalize, se2_defect,
-  se2_generator
+  se2_generator, &dm_lie_sym_se2
 };

@@ -295,5 +295,5 @@ const dm_lie_type dm_lie_type_se3 = {
   "SE3", DM_LIE_SE3, se3_identity, se3_compose, se3_inverse, se3_exp, se3_log,
   se3_Ad, se3_ad, se3_bracket, se3_dexp, se3_cay, se3_icay, se3_dcay, se3_hat,
   se3_vee, se3_matrix, se3_from_matrix, se3_act, se3_normalize, se3_defect,
-  se3_generator
+  se3_generator, &dm_lie_sym_se3
 };

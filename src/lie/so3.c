@@ -273,7 +273,7 @@ const dm_lie_type dm_lie_type_so3 = {
   "SO3", DM_LIE_SO3, so3_identity, so3_compose, so3_inverse, so3_exp, so3_log,
   so3_Ad, so3_ad, so3_bracket, so3_dexp, so3_cay, so3_icay, so3_dcay, so3_hat,
   so3_vee, so3_matrix, so3_from_matrix, so3_act, so3_normalize, so3_defect,
-  so3_generator
+  so3_generator, &dm_lie_sym_so3
 };
 
 /* }====================================================================== */
