@@ -64,7 +64,7 @@ void dm_dec_meshdata_free(dm_dec_meshdata *m);
  *   grid:    [x0,x1] x [y0,y1], nx x ny squares, each square [a,b,d,c] split
  *            along its diagonal a-d (right triangles).
  *   disc:    radius r, nr rings of 6i vertices (1 + 3 nr (nr+1) vertices,
- *            6 nr^2 nearly equilateral triangles).
+ *            6 nr^2 nearly equilateral triangles), made Delaunay by flips.
  *   annulus: radii r0 < r1, nr rings of m vertices, odd rings turned by half
  *            a step (m >= 3, nr >= 1).
  *   sphere:  radius r, icosahedron subdivided `level` times 1 -> 4 (10 4^L + 2
@@ -84,6 +84,11 @@ dm_dec_meshdata *dm_dec_gen_torus(double R, double r, int m, int n, dm_err *e);
 dm_dec_meshdata *dm_dec_gen_box(int nx, int ny, int nz, double a, double b,
                                 double c, dm_err *e);
 dm_dec_meshdata *dm_dec_gen_path(int np, const double *x, dm_err *e);
+
+/* Lawson edge flips until every interior edge of a planar triangle mesh is
+ * locally Delaunay (opposite angles summing to at most pi, i.e. *_1 >= 0);
+ * returns the number of flips (>= 0) or minus a status. */
+int dm_dec_delaunay_flips(dm_dec_meshdata *m, dm_err *e);
 
 /* One level of nested refinement: every triangle split 1 -> 4 at edge
  * midpoints (n = 2), every segment 1 -> 2 (n = 1).  When parent is not NULL
@@ -200,6 +205,23 @@ dm_sparse *dm_dec_codiff(const dm_dec_geom *G, int k, dm_err *e);
  * form S = *_k Delta_k (either pointer may be NULL). */
 int dm_dec_laplacian(const dm_dec_geom *G, int k, dm_sparse **delta,
                      dm_sparse **sym, dm_err *e);
+
+/* A user function of a point x (N coordinates) writing its values into
+ * vals; returns 0, or nonzero to stop the caller with DM_ECALLBACK. */
+typedef int (*dm_dec_fn)(const double *x, double *vals, void *ud);
+
+/* The de Rham map: the k-cochain of integrals of a form over the primal
+ * k-simplices (embedded geometries only).
+ *   k = 0: f(x) at the vertices (1 value);
+ *   k = 1: f returns the N components of a 1-form; integral along every
+ *          edge (tail = lower vertex) by 3-point Gauss-Legendre, exact for
+ *          polynomial coefficients of degree <= 5;
+ *   k = n = N (2 or 3): f returns the density of f dx^1...dx^n; integral
+ *          over every top simplex with its orientation, exact for
+ *          polynomials of degree <= 5 (triangles) or 3 (tetrahedra).
+ * Other degrees: DM_EUNSUP. */
+int dm_dec_derham(const dm_dec_geom *G, int k, dm_dec_fn f, void *ud, double *out,
+                  dm_err *e);
 
 /* }==== */
 

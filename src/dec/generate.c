@@ -45,6 +45,15 @@ void dm_dec_meshdata_free(dm_dec_meshdata *m)
   free(m);
 }
 
+typedef struct {
+  size_t cap;
+  int64_t *key;
+  int *val;
+} edgemap;
+static int edgemap_init(edgemap *h, size_t nedges);
+static void edgemap_free(edgemap *h);
+static int midpoint(edgemap *h, int a, int b, int *next, int *parent);
+
 static int bad(dm_err *e, const char *what, const char *cond)
 {
   return dm_err_set(e, DM_EINVAL, "%s: %s", what, cond);
@@ -118,6 +127,74 @@ static int zipper(int *T, int ia, int a, double offa, int ib, int b, double offb
   return t;
 }
 
+/* cot of the angle at c in triangle (a, b, c) of the plane. */
+static double cot_at(const double *X, int a, int b, int c)
+{
+  double ux = X[2 * a] - X[2 * c], uy = X[2 * a + 1] - X[2 * c + 1];
+  double vx = X[2 * b] - X[2 * c], vy = X[2 * b + 1] - X[2 * c + 1];
+  return (ux * vx + uy * vy) / fabs(ux * vy - uy * vx);
+}
+
+int dm_dec_delaunay_flips(dm_dec_meshdata *m, dm_err *e)
+{
+  edgemap h = {0, NULL, NULL};
+  int *owner = NULL, *parent = NULL, flips = 0, changed = 1, t, i, pass;
+  unsigned char *touched = NULL;
+  if (m->n != 2 || m->N != 2)
+    return dm_err_set(e, DM_EUNSUP, "Delaunay flips: planar triangle meshes only");
+  owner = malloc(3 * (size_t)m->ntop * 2 * sizeof *owner);
+  parent = malloc(2 * ((size_t)m->nv + 3 * (size_t)m->ntop) * sizeof *parent);
+  touched = malloc((size_t)m->ntop);
+  if (owner == NULL || parent == NULL || touched == NULL)
+    goto nomem;
+  for (pass = 0; changed && pass < 1000; pass++) {
+    int next = m->nv;
+    changed = 0;
+    edgemap_free(&h);
+    if (edgemap_init(&h, 3 * (size_t)m->ntop) != 0)
+      goto nomem;
+    memset(touched, 0, (size_t)m->ntop);
+    /* owner[2 id] = the triangle having the edge (lo, hi) in that order,
+     * owner[2 id + 1] = the one having (hi, lo) */
+    for (i = 0; i < 6 * m->ntop; i++)
+      owner[i] = -1;
+    for (t = 0; t < m->ntop; t++)
+      for (i = 0; i < 3; i++) {
+        int a = m->T[3 * t + i], b = m->T[3 * t + (i + 1) % 3];
+        int id = midpoint(&h, a, b, &next, parent) - m->nv;
+        owner[2 * id + (a < b ? 0 : 1)] = t;
+      }
+    for (t = 0; t < m->ntop; t++)
+      for (i = 0; i < 3 && !touched[t]; i++) {
+        int a = m->T[3 * t + i], b = m->T[3 * t + (i + 1) % 3], c = m->T[3 * t + (i + 2) % 3];
+        int id = midpoint(&h, a, b, &next, parent) - m->nv, u = owner[2 * id + (a < b ? 1 : 0)], d = -1, j;
+        if (u < 0 || touched[u])
+          continue;
+        for (j = 0; j < 3; j++)
+          if (m->T[3 * u + j] != a && m->T[3 * u + j] != b)
+            d = m->T[3 * u + j];
+        if (cot_at(m->X, a, b, c) + cot_at(m->X, b, a, d) >= -1e-12)
+          continue;
+        m->T[3 * t] = a; m->T[3 * t + 1] = d; m->T[3 * t + 2] = c;
+        m->T[3 * u] = d; m->T[3 * u + 1] = b; m->T[3 * u + 2] = c;
+        touched[t] = touched[u] = 1;
+        flips++;
+        changed = 1;
+      }
+  }
+  edgemap_free(&h);
+  free(owner);
+  free(parent);
+  free(touched);
+  return flips;
+nomem:
+  edgemap_free(&h);
+  free(owner);
+  free(parent);
+  free(touched);
+  return -dm_err_set(e, DM_ENOMEM, "Delaunay flips: out of memory");
+}
+
 dm_dec_meshdata *dm_dec_gen_disc(double r, int nr, dm_err *e)
 {
   dm_dec_meshdata *m;
@@ -146,6 +223,10 @@ dm_dec_meshdata *dm_dec_gen_disc(double r, int nr, dm_err *e)
     v += a;
   }
   orient_ccw(m);
+  if (dm_dec_delaunay_flips(m, e) < 0) {
+    dm_dec_meshdata_free(m);
+    return NULL;
+  }
   return m;
 }
 
@@ -170,6 +251,10 @@ dm_dec_meshdata *dm_dec_gen_annulus(double r0, double r1, int nr, int mm, dm_err
     t += zipper(m->T + 3 * t, i * mm, mm, 0.5 * (i % 2), (i + 1) * mm, mm,
                 0.5 * ((i + 1) % 2));
   orient_ccw(m);
+  if (dm_dec_delaunay_flips(m, e) < 0) {
+    dm_dec_meshdata_free(m);
+    return NULL;
+  }
   return m;
 }
 
@@ -209,12 +294,6 @@ dm_dec_meshdata *dm_dec_gen_torus(double R, double r, int mu, int nv, dm_err *e)
 }
 
 /* {==== edge midpoints (open addressing on the sorted pair) ===================== */
-
-typedef struct {
-  size_t cap;
-  int64_t *key;
-  int *val;
-} edgemap;
 
 static int edgemap_init(edgemap *h, size_t nedges)
 {

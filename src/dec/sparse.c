@@ -294,6 +294,27 @@ dm_sparse *dm_sparse_select(const dm_sparse *A, const unsigned char *keeprow,
   return B;
 }
 
+dm_sparse *dm_sparse_fix_rows(const dm_sparse *A, const unsigned char *fixed, dm_err *e)
+{
+  int i, p, out = 0;
+  dm_sparse *B = dm_sparse_alloc(A->nrows, A->ncols, dm_sparse_nnz(A) + A->nrows, e);
+  if (B == NULL)
+    return NULL;
+  for (i = 0; i < A->nrows; i++) {
+    if (fixed[i]) {
+      B->col[out] = i;
+      B->val[out++] = 1.0;
+    } else {
+      for (p = A->rowptr[i]; p < A->rowptr[i + 1]; p++) {
+        B->col[out] = A->col[p];
+        B->val[out++] = A->val[p];
+      }
+    }
+    B->rowptr[i + 1] = out;
+  }
+  return B;
+}
+
 void dm_sparse_scale(dm_sparse *A, const double *r, const double *c)
 {
   int i, p;

@@ -26,8 +26,8 @@
  * dm_sparse_eigsh uses ARPACK, whose reverse-communication routines keep
  * static state: one call at a time per process.
  */
-#ifndef DM_SPARSE_H
-#define DM_SPARSE_H
+#ifndef DM_DEC_SPARSE_H
+#define DM_DEC_SPARSE_H
 
 #include "core/status.h"
 
@@ -64,6 +64,9 @@ dm_sparse *dm_sparse_drop(const dm_sparse *A, double tol, dm_err *e);
  * keeps all. */
 dm_sparse *dm_sparse_select(const dm_sparse *A, const unsigned char *keeprow,
                             const unsigned char *keepcol, dm_err *e);
+
+/* A copy of the square matrix A whose flagged rows are identity rows. */
+dm_sparse *dm_sparse_fix_rows(const dm_sparse *A, const unsigned char *fixed, dm_err *e);
 
 /* In place: A <- diag(r) A diag(c) (either may be NULL). */
 void dm_sparse_scale(dm_sparse *A, const double *r, const double *c);

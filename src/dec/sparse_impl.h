@@ -1,6 +1,6 @@
 /* sparse_impl.h -- private to src/dec/sparse*.c: CHOLMOD glue. */
-#ifndef DM_SPARSE_IMPL_H
-#define DM_SPARSE_IMPL_H
+#ifndef DM_DEC_SPARSE_IMPL_H
+#define DM_DEC_SPARSE_IMPL_H
 
 #include <suitesparse/cholmod.h>
 

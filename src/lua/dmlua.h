@@ -136,6 +136,7 @@ void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
 /* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
  * bindings whose objects make integrators (red:integrator). */
 int dm_lua_integrator(lua_State *L);
+void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

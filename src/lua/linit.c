@@ -16,6 +16,7 @@ static const dm_opener openers[] = {
   dm_open_builtin,
   dm_open_integrator,
   dm_open_reduce,
+  dm_open_dec,
   NULL
 };
 

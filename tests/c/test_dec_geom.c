@@ -555,6 +555,15 @@ int main(void)
     drop(&r);
     drop(&q);
   }
+  /* the disc generator is Delaunay after its flips */
+  {
+    mesh r = make(dm_dec_gen_disc(1.0, 32, NULL));
+    dm_dec_meshdata *m = dm_dec_gen_disc(1.0, 32, NULL);
+    tap_ok(r.G->nonpos[1] == 0 && r.G->nonpos[0] == 0, "disc of 32 rings: every *1 and *0 positive");
+    tap_is_int(dm_dec_delaunay_flips(m, NULL), 0, "a second round of flips finds nothing");
+    dm_dec_meshdata_free(m);
+    drop(&r);
+  }
   dm_dec_geom_free(NULL);
   return tap_done();
 }
