@@ -1,25 +1,21 @@
 -- dmech.print -- the REPL's pretty printer.
 --
--- Numbers print as the shortest decimal that reads back exactly; strings are
+-- Numbers print as the shortest decimal that reads back exactly (the C
+-- formatter dm.format_number, '.' whatever the locale); strings are
 -- quoted; objects with __tostring (vec, mat, trajectories, expressions) print
 -- through it; tables print to a depth of 3 with at most MAX_ITEMS entries per
 -- level, sorted keys and cycle detection.
 local M = {}
+local format_number = require("dmech.core").format_number
 
 local MAX_ITEMS = 24
 local MAX_DEPTH = 3
 
 local function fmtnum(x)
   if math.type(x) == "integer" then return tostring(x) end
-  if x ~= x then return "nan" end
-  if x == math.huge then return "inf" elseif x == -math.huge then return "-inf" end
-  for prec = 15, 17 do
-    local s = string.format("%." .. prec .. "g", x)
-    if tonumber(s) == x then
-      if not s:find("[%.eEn]") then s = s .. ".0" end
-      return s
-    end
-  end
+  local s = format_number(x)
+  if not s:find("[%.eEni]") then s = s .. ".0" end      -- a float: 2.0, not 2
+  return s
 end
 M.fmtnum = fmtnum
 

@@ -89,3 +89,19 @@ int dm_num_format(char *buf, size_t size, double x)
   dm_num_leave(old);
   return snprintf(buf, size, "%s", tmp);
 }
+
+const char *dm_num_format_vec(char *buf, size_t size, const double *x, size_t n)
+{
+  size_t i, k = 0;
+  locale_t old;
+  if (size == 0)
+    return buf;
+  old = dm_num_enter();
+  k += (size_t)snprintf(buf, size, "(");
+  for (i = 0; i < n && i < 6 && k < size; i++)
+    k += (size_t)snprintf(buf + k, size - k, "%s%.6g", i ? ", " : "", x[i]);
+  if (k < size)
+    snprintf(buf + k, size - k, "%s)", n > 6 ? ", ..." : "");
+  dm_num_leave(old);
+  return buf;
+}

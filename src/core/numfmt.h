@@ -39,7 +39,11 @@
 /* Shortest round-trip text of x into buf (see above); returns its length. */
 int dm_num_format(char *buf, size_t size, double x);
 
-/* snprintf / vsnprintf / fprintf / vfprintf in the "C" locale. */
+/* "(x1, x2, ...)" with %.6g (at most 6 entries, then ", ...") into buf, for
+ * messages; returns buf. */
+const char *dm_num_format_vec(char *buf, size_t size, const double *x, size_t n);
+
+/* snprintf / vsnprintf / fprintf in the "C" locale. */
 int dm_num_snprintf(char *buf, size_t size, const char *fmt, ...)
 #if defined(__GNUC__)
   __attribute__((format(printf, 3, 4)))

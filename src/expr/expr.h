@@ -198,8 +198,5 @@ int dm_expr_eval(dm_expr_ctx *ctx, size_t ne, const dm_expr *e, double *out,
  * malloc'ed string or NULL (out of memory / invalid handle; err filled). */
 char *dm_expr_to_string(dm_expr_ctx *ctx, dm_expr e, size_t max_len,
                         dm_err *err);
-/* Shortest decimal (%.15g, %.16g or %.17g) that reads back as x; "inf",
- * "-inf", "nan".  Returns the length (snprintf semantics). */
-int dm_expr_fmtnum(char *buf, size_t size, double x);
 
 #endif

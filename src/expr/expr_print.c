@@ -4,26 +4,12 @@
  * can be exponentially long. */
 #include <config.h>
 #include "expr/expr_impl.h"
+#include "core/numfmt.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-int dm_expr_fmtnum(char *buf, size_t size, double x)
-{
-  if (isnan(x))
-    return snprintf(buf, size, "nan");
-  if (isinf(x))
-    return snprintf(buf, size, x > 0 ? "inf" : "-inf");
-  char tmp[40];
-  for (int prec = 15; prec <= 17; prec++) {
-    snprintf(tmp, sizeof tmp, "%.*g", prec, x);
-    if (prec == 17 || strtod(tmp, NULL) == x)
-      break;
-  }
-  return snprintf(buf, size, "%s", tmp);
-}
 
 /* {==================================================================
  * growable output
@@ -173,7 +159,7 @@ static int step(fstack *st, const dm_expr_ctx *ctx, sbuf *b)
     put(b, "(");
   if (arity == 0) {                                 /* leaf */
     if (nd.op == DM_EXPR_CONST) {
-      dm_expr_fmtnum(num, sizeof num, ctx->cval[nd.a]);
+      dm_num_format(num, sizeof num, ctx->cval[nd.a]);
       put(b, num);
     } else {
       put(b, ctx->names[nd.a]);

@@ -1,6 +1,7 @@
 /* native.c -- emit C for a tape, compile it with the system compiler, load
  * it, check it against the tape, cache the object.  See native.h. */
 #include <config.h>
+#include "core/numfmt.h"
 #include "expr/native_impl.h"
 
 #include <dlfcn.h>
@@ -119,7 +120,7 @@ static void operand(char *buf, size_t size, const dm_tape *t, uint32_t r,
     else if (isinf(c))
       snprintf(buf, size, c > 0 ? "HUGE_VAL" : "(-HUGE_VAL)");
     else
-      snprintf(buf, size, "(%a)", c);
+      dm_num_snprintf(buf, size, "(%a)", c);     /* '.' whatever LC_NUMERIC says */
   } else {
     snprintf(buf, size, "%c%zu", writer[r] & SECOND ? 'u' : 't',
              writer[r] & ~SECOND);

@@ -53,8 +53,6 @@ static inline int dm_eval_constr(const dm_system *sys, const double *q, unsigned
   return rc == 0 ? DM_OK : dm_eval_fail(rc, "constraint evaluation", q, sys->n, e);
 }
 
-/* "(x1, x2, ...)" into buf (at most 6 entries). */
-const char *dm_fmt_vec(char *buf, size_t len, const double *x, size_t n);
 
 
 /* {==== Legendre map ===================================================== */

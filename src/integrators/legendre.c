@@ -3,6 +3,7 @@
  * its exact Jacobian (for the non-symplectic reference methods).
  * See integ_impl.h; workspaces are allocated once by dm_legendre_alloc. */
 #include <config.h>
+#include "core/numfmt.h"
 #include "integrators/integ_impl.h"
 
 #include <float.h>
@@ -91,7 +92,7 @@ static int singular_lvv(const dm_system *sys, const double *q, const double *v, 
   return dm_err_set(e, DM_ESINGULAR,
                     "d2L/dv2 is singular at q = %s, v = %s: the Lagrangian of '%s' is not "
                     "regular (its Hessian in the velocities must be invertible)",
-                    dm_fmt_vec(bq, sizeof bq, q, sys->n), dm_fmt_vec(bv, sizeof bv, v, sys->n),
+                    dm_num_format_vec(bq, sizeof bq, q, sys->n), dm_num_format_vec(bv, sizeof bv, v, sys->n),
                     sys->name ? sys->name : "system");
 }
 

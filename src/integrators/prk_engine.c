@@ -32,6 +32,7 @@
  *   dp1 = dp0 + h sum_j b_j (D_j dQ_j + Bm_j dV_j).
  */
 #include <config.h>
+#include "core/numfmt.h"
 #include "integrators/prk_impl.h"
 #include "integrators/prk_kernels.h"
 #include "core/interrupt.h"
@@ -312,8 +313,8 @@ int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
       return dm_err_set(e, DM_ESINGULAR,
                         "d2L/dv2 is singular at stage %zu (q = %s, v = %s): the Lagrangian of "
                         "'%s' is not regular (its Hessian in the velocities must be invertible)",
-                        i + 1, dm_fmt_vec(bq, sizeof bq, P->Q + i * n, n),
-                        dm_fmt_vec(bv, sizeof bv, P->X + i * n, n),
+                        i + 1, dm_num_format_vec(bq, sizeof bq, P->Q + i * n, n),
+                        dm_num_format_vec(bv, sizeof bv, P->X + i * n, n),
                         P->sys->name ? P->sys->name : "system");
   }
   return dm_err_set(e, DM_ESINGULAR, "singular Newton matrix of the %s (h = %g)%s", what, h,

@@ -36,9 +36,10 @@ static int progress_draw(void *ctx, const dm_run_progress *pr)
     return 0;
   pg->last = pr->elapsed;
   rate = pr->elapsed > 0 ? (double)pr->step / pr->elapsed : 0;
-  fprintf(stderr, "\r  run: step %ld/%ld (%4.1f%%)  t = %-12.6g %9.3g steps/s  ETA %.0f s  ",
-          pr->step, pr->nsteps, pr->nsteps ? 100.0 * (double)pr->step / (double)pr->nsteps : 100.0,
-          pr->t, rate, rate > 0 ? (double)(pr->nsteps - pr->step) / rate : 0.0);
+  dm_num_fprintf(stderr, "\r  run: step %ld/%ld (%4.1f%%)  t = %-12.6g %9.3g steps/s  ETA %.0f s  ",
+                 pr->step, pr->nsteps,
+                 pr->nsteps ? 100.0 * (double)pr->step / (double)pr->nsteps : 100.0, pr->t, rate,
+                 rate > 0 ? (double)(pr->nsteps - pr->step) / rate : 0.0);
   fflush(stderr);
   pg->shown = 1;
   return 0;

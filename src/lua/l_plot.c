@@ -307,9 +307,12 @@ static int gp_terminal(lua_State *L)
       return luaL_error(L, "size: {width, height} expected");
     req.width = lua_tonumber(L, -2);
     req.height = lua_tonumber(L, -1);
-    if (!(req.width > 0 && req.height > 0))
-      return luaL_error(L, "size: two positive numbers expected, got %f,%f",
-                        req.width, req.height);
+    if (!(req.width > 0 && req.height > 0)) {
+      char a[DM_NUM_BUFSIZE], b[DM_NUM_BUFSIZE];
+      dm_num_format(a, sizeof a, req.width);
+      dm_num_format(b, sizeof b, req.height);
+      return luaL_error(L, "size: two positive numbers expected, got %s,%s", a, b);
+    }
   }
   s = session(L);
   rc = dm_gp_set_terminal(s, &req, &e);

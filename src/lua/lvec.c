@@ -467,7 +467,20 @@ static const luaL_Reg vec_meta[] = {
   {NULL, NULL}
 };
 
+/* dm.format_number(x): the text every number of dmech is printed and
+ * written as (core/numfmt.h) */
+static int l_format_number(lua_State *L)
+{
+  char buf[DM_NUM_BUFSIZE];
+  double x = luaL_checknumber(L, 1);
+  lua_pushstring(L, (dm_num_format(buf, sizeof buf, x), buf));
+  return 1;
+}
+
 static const dm_reg vec_funcs[] = {
+  {"format_number", l_format_number, "dm.format_number(x) -> string",
+   "The shortest decimal that reads back as exactly x (\"0.1\", \"2.385\", \"1e-300\", "
+   "\"nan\", \"inf\"), with '.' whatever the locale: how dmech prints and writes numbers."},
   {"vec", l_vec, "dm.vec(n | {x1, ...} | v | x1, x2, ...) -> vec",
    "A vector of n zeros, or of the given numbers (a copy when given a vec)."},
   {"linspace", l_linspace, "dm.linspace(a, b, n) -> vec",

@@ -1,6 +1,6 @@
 /* datablock.c -- numbers to gnuplot as named datablocks.
  *
- * Rows are "%.17g %.17g ...\n" formatted under a "C" locale_t, so a
+ * Rows are "%.17g %.17g ...\n" formatted in the "C" locale (numfmt.h), so a
  * decimal comma in LC_NUMERIC can never reach gnuplot; non-finite values
  * are written NaN (an undefined point: a gap in a line).
  *
@@ -14,7 +14,6 @@
 
 #include <dirent.h>
 #include <errno.h>
-#include <locale.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +21,7 @@
 #include <unistd.h>
 
 #include "core/interrupt.h"
+#include "core/numfmt.h"
 #include "plot/gp_private.h"
 
 static size_t fmt_number(char *p, double x)
@@ -167,12 +167,12 @@ int dm_gp_datablock(dm_gp_session *s, const char *name, size_t nrows,
                       ncols);
   if (s->pid <= 0)
     return dm_err_set(e, DM_EIO, "gnuplot is not running");
-  old = uselocale(s->cloc);
+  old = dm_num_enter();
   if (nrows > DM_GP_INLINE_ROWS)
     rc = block_file(s, name, nrows, ncols, cols, strides, &done, e);
   else
     rc = block_inline(s, name, nrows, ncols, cols, strides, &done, e);
-  uselocale(old);
+  dm_num_leave(old);
   if (rc == DM_OK && done < nrows)
     rc = dm_err_set(e, DM_EINTR, "interrupted while sending data to gnuplot "
                     "($%s has %zu of %zu rows)", name, done, nrows);

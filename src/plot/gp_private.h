@@ -3,7 +3,6 @@
 #ifndef DM_GP_PRIVATE_H
 #define DM_GP_PRIVATE_H
 
-#include <locale.h>
 #include <stdio.h>
 #include <sys/types.h>
 
@@ -34,7 +33,6 @@ struct dm_gp_session {
   char *program;          /* NULL: $DMECH_GNUPLOT or "gnuplot" */
   double timeout;         /* seconds of silence before "hung" */
   FILE *log;
-  locale_t cloc;          /* "C" numeric locale for formatting */
 
   gp_buf wbuf;            /* text waiting to be written */
   size_t woff;            /* bytes of wbuf already written */

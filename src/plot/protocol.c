@@ -9,7 +9,6 @@
 #include <config.h>
 
 #include <errno.h>
-#include <locale.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -20,6 +19,7 @@
 #include <unistd.h>
 
 #include "core/interrupt.h"
+#include "core/numfmt.h"
 #include "plot/gp_private.h"
 
 #define GP_DEFAULT_TIMEOUT 30.0
@@ -92,14 +92,9 @@ dm_gp_session *dm_gp_session_alloc(void)
   s->pid = -1;
   s->fd_in = s->fd_out = s->fd_err = -1;
   s->timeout = GP_DEFAULT_TIMEOUT;
-  s->cloc = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-  if (s->cloc == (locale_t)0) {
-    free(s);
-    return NULL;
-  }
   env = getenv("DMECH_GNUPLOT_TIMEOUT");
   if (env != NULL && *env != '\0') {
-    double t = strtod_l(env, NULL, s->cloc);
+    double t = dm_num_parse(env, NULL);
     if (t > 0 && isfinite(t))
       s->timeout = t;
   }
@@ -128,7 +123,6 @@ void dm_gp_session_free(dm_gp_session *s)
   gp_data_cleanup(s, 1);
   if (s->log != NULL)
     fclose(s->log);
-  freelocale(s->cloc);
   free(s->program);
   gp_buf_free(&s->wbuf);
   gp_buf_free(&s->obuf);
@@ -232,7 +226,7 @@ int dm_gp_send(dm_gp_session *s, dm_err *e, const char *fmt, ...)
   locale_t old;
   char small[512], *big = NULL;
   int n, rc;
-  old = uselocale(s->cloc);
+  old = dm_num_enter();
   va_start(ap, fmt);
   n = vsnprintf(small, sizeof small, fmt, ap);
   va_end(ap);
@@ -244,7 +238,7 @@ int dm_gp_send(dm_gp_session *s, dm_err *e, const char *fmt, ...)
       va_end(ap);
     }
   }
-  uselocale(old);
+  dm_num_leave(old);
   if (n < 0 || (n >= (int)sizeof small && big == NULL))
     return dm_err_set(e, DM_ENOMEM, "cannot format gnuplot command");
   rc = gp_append(s, big != NULL ? big : small, (size_t)n, e);
@@ -398,7 +392,7 @@ static int probe(dm_gp_session *s, dm_err *e)
     return rc;
   v = strstr(s->msgs.p, "DMECH_VERSION ");
   t = strstr(s->msgs.p, "DMECH_TERMINALS ");
-  s->version = v != NULL ? strtod_l(v + 14, &end, s->cloc) : 0;
+  s->version = v != NULL ? dm_num_parse(v + 14, &end) : 0;
   if (gp_errno != 0 || v == NULL || t == NULL) {
     const char *prog = gp_program(s);
     gp_kill(s);

@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/numfmt.h"
 #include "plot/gp_private.h"
 
 /* {==== the choice ========================================================== */
@@ -234,8 +235,8 @@ int dm_gp_terminal_command(const dm_gp_session *s, const dm_gp_termreq *req,
   }
   if (w > 0 && k < size) {
     if (is_one_of(name, paper))
-      k += (size_t)snprintf(out + k, size - k, " size %.6gin,%.6gin", w / 72.0,
-                            h / 72.0);
+      k += (size_t)dm_num_snprintf(out + k, size - k, " size %.6gin,%.6gin", w / 72.0,
+                                   h / 72.0);
     else if (is_one_of(name, pixels) || strcmp(name, "dumb") == 0)
       k += (size_t)snprintf(out + k, size - k, " size %d,%d", (int)(w + 0.5),
                             (int)(h + 0.5));

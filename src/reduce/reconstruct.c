@@ -6,6 +6,7 @@
  * psi_mu(x_k, x_{k+1}) on the Lagrangian side), and the split of the group
  * advance over a closed shape loop into dynamic and geometric phases. */
 #include <config.h>
+#include "core/numfmt.h"
 #include "reduce/routh_impl.h"
 #include "core/interrupt.h"
 
@@ -47,18 +48,18 @@ static int shift_at(dm_routh *red, scr *S, const double *x, const double *mu, do
   for (i = 0; i < r * r; i++)
     if (!isfinite(S->tout[i]))
       return dm_err_set(e, DM_ESINGULAR, "the locked inertia is not finite at x = %s",
-                        dm_rfmt_vec(bx, sizeof bx, x, s));
+                        dm_num_format_vec(bx, sizeof bx, x, s));
   dm_routh_sym_eig(S->tout, r, &lmin, &lmax);
   if (!(lmin > 1e-14 * fmax(lmax, 1e-300)) || !(lmax > 0.0))
     return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) is singular at x = %s (smallest "
                       "eigenvalue %.3g): the symmetry group does not act freely there",
-                      dm_rfmt_vec(bx, sizeof bx, x, s), lmin);
+                      dm_num_format_vec(bx, sizeof bx, x, s), lmin);
   memcpy(S->tin, x, s * sizeof(double));
   memset(S->tin + s, 0, s * sizeof(double));
   dm_rprog_run(&red->gyro_r, S->tin, S->par2, S->tout, S->twork);
   for (i = 0; i < s; i++) {
     if (!isfinite(S->tout[i]))
-      return dm_err_set(e, DM_EDOM, "mu^T A is not finite at x = %s", dm_rfmt_vec(bx, sizeof bx, x, s));
+      return dm_err_set(e, DM_EDOM, "mu^T A is not finite at x = %s", dm_num_format_vec(bx, sizeof bx, x, s));
     a[i] = S->tout[i];
   }
   return DM_OK;

@@ -685,17 +685,3 @@ double dm_rnorm_inf(const double *x, size_t n)
   }
   return z == z ? m : NAN;
 }
-
-const char *dm_rfmt_vec(char *buf, size_t len, const double *x, size_t n)
-{
-  size_t k = 0, i;
-  if (len == 0)
-    return buf;
-  buf[0] = '\0';
-  k += (size_t)snprintf(buf + k, len - k, "(");
-  for (i = 0; i < n && i < 6 && k < len; i++)
-    k += (size_t)snprintf(buf + k, len - k, "%s%.6g", i ? ", " : "", x[i]);
-  if (k < len)
-    snprintf(buf + k, len - k, "%s)", n > 6 ? ", ..." : "");
-  return buf;
-}

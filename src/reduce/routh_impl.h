@@ -164,7 +164,6 @@ int dm_rlu_factor(dm_rlu *lu, double *a, size_t N);
 void dm_rlu_solve(const dm_rlu *lu, const double *a, size_t N, double *rhs);
 
 double dm_rnorm_inf(const double *x, size_t n);
-const char *dm_rfmt_vec(char *buf, size_t len, const double *x, size_t n);
 
 /* RSPRK engine (rsprk.c): the reduced symplectic PRK step of thesis eq.
  * 2.5.14 on T*S for any PRK tableau, constraints with Lobatto-type

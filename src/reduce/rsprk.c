@@ -23,6 +23,7 @@
  * A(X_j) Xd_j.  The step Jacobian comes from the implicit function theorem
  * on the converged stage equations. */
 #include <config.h>
+#include "core/numfmt.h"
 #include "reduce/rsprk_impl.h"
 #include "integrators/prk_kernels.h"
 #include "core/interrupt.h"
@@ -93,13 +94,13 @@ int dm_routh_check_inertia(const dm_routh *red, const double *x, double *ref, do
   for (i = 0; i < r * r; i++)
     if (!isfinite(work[i]))
       return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) is not finite at %s x = %s",
-                        where, dm_rfmt_vec(bx, sizeof bx, x, red->s));
+                        where, dm_num_format_vec(bx, sizeof bx, x, red->s));
   dm_routh_sym_eig(work, r, &lmin, &lmax);
   if (!(*ref > 0.0)) {
     if (!(lmin > 0.0))
       return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) is singular at %s x = %s "
                         "(smallest eigenvalue %.3g): the symmetry group does not act freely there",
-                        where, dm_rfmt_vec(bx, sizeof bx, x, red->s), lmin);
+                        where, dm_num_format_vec(bx, sizeof bx, x, red->s), lmin);
     *ref = lmax;
     return DM_OK;
   }
@@ -107,7 +108,7 @@ int dm_routh_check_inertia(const dm_routh *red, const double *x, double *ref, do
     return dm_err_set(e, DM_ESINGULAR, "the locked inertia I(x) became singular at %s x = %s "
                       "(smallest eigenvalue %.3g <= %.3g x its initial size %.3g): the symmetry "
                       "group does not act freely there (e.g. r -> 0) and the reduced equations "
-                      "break down", where, dm_rfmt_vec(bx, sizeof bx, x, red->s), lmin,
+                      "break down", where, dm_num_format_vec(bx, sizeof bx, x, red->s), lmin,
                       red->sing_tol, *ref);
   return DM_OK;
 }
@@ -232,9 +233,9 @@ static int cb_fail(dm_rsprk *P, int st, const char *what, const double *x, dm_er
   char bx[200];
   if (st > 0)
     return dm_err_set(e, DM_EDOM, "%s is not finite / outside its domain at x = %s", what,
-                      dm_rfmt_vec(bx, sizeof bx, x, P->d));
+                      dm_num_format_vec(bx, sizeof bx, x, P->d));
   return dm_err_set(e, DM_ECALLBACK, "%s callback failed (status %d) at x = %s", what, st,
-                    dm_rfmt_vec(bx, sizeof bx, x, P->d));
+                    dm_num_format_vec(bx, sizeof bx, x, P->d));
 }
 
 /* muA (and K = d muA/dx when K != NULL) at a node point x (velocity 0) */
