@@ -2,15 +2,69 @@
  *
  * Used twice: linked into the dmech program (where it is preloaded) and built
  * as the Lua C module dmech.so for stock lua5.4.  It builds the table of C
- * functions, makes the Lua-side library findable (DMECH_PATH first, then the
- * installed data directory, then the source tree it was built from) and hands
- * the table to dmech.init, whose result is the module.
+ * functions, makes the Lua-side library findable and hands the table to
+ * dmech.init, whose result is the module.
+ *
+ * Where the Lua-side library is: the directories of DMECH_PATH first; then,
+ * for a program or module still in its build tree, the source tree's lua/
+ * named by the file UNINSTALLED_MARK that the build writes next to src/dmech
+ * (looked for beside the running executable or module and one directory up,
+ * for src/.libs/dmech.so) and that is never installed; otherwise the
+ * installed data directory DMECH_LUADIR only.  No source path is compiled
+ * into the binaries.
  */
 #include <config.h>
+#include <dlfcn.h>
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lua/dmlua.h"
+
+#define UNINSTALLED_MARK "dmech-uninstalled.path"
+
+/* The file this code runs from: the module for dmech.so, else the program. */
+static int own_path(char *buf, size_t size)
+{
+  Dl_info info;
+  ssize_t k;
+  if (dladdr((void *)luaopen_dmech, &info) != 0 && info.dli_fname != NULL
+      && strstr(info.dli_fname, ".so") != NULL && realpath(info.dli_fname, buf) != NULL)
+    return 1;
+  k = readlink("/proc/self/exe", buf, size - 1);
+  if (k <= 0)
+    return 0;
+  buf[k] = '\0';
+  return 1;
+}
+
+/* The Lua directory of the build tree this binary belongs to, into dir
+ * (size PATH_MAX); 0 when it is not in a build tree (installed). */
+static int uninstalled_dir(char *dir)
+{
+  char self[PATH_MAX], mark[PATH_MAX + 64];
+  int up;
+  if (!own_path(self, sizeof self))
+    return 0;
+  for (up = 0; up < 2; up++) {
+    char *slash = strrchr(self, '/');
+    FILE *f;
+    if (slash == NULL)
+      return 0;
+    *slash = '\0';
+    snprintf(mark, sizeof mark, "%s/" UNINSTALLED_MARK, self);
+    if ((f = fopen(mark, "re")) == NULL)
+      continue;
+    if (fgets(dir, PATH_MAX, f) == NULL)
+      dir[0] = '\0';
+    fclose(f);
+    dir[strcspn(dir, "\n")] = '\0';
+    return dir[0] != '\0';
+  }
+  return 0;
+}
 
 /* Prepend "<dir>/?.lua" for every directory we search to package.path, once. */
 static void setpath(lua_State *L)
@@ -42,7 +96,15 @@ static void setpath(lua_State *L)
       p = q + 1;
     }
   }
-  luaL_addstring(&b, DMECH_LUADIR "/?.lua;" DMECH_SRC_LUADIR "/?.lua;");
+  {
+    char dir[PATH_MAX];
+    if (uninstalled_dir(dir)) {
+      luaL_addstring(&b, dir);
+      luaL_addstring(&b, "/?.lua;");
+    } else {
+      luaL_addstring(&b, DMECH_LUADIR "/?.lua;");
+    }
+  }
   lua_getfield(L, -2, "path");
   luaL_addvalue(&b);
   luaL_pushresult(&b);

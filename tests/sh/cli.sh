@@ -45,7 +45,20 @@ out=$(DMECH_INIT='error("bad init")' "$D" -e 'print(1)' 2>&1); st=$?; like "$out
 mkdir -p "$T/lib/dmech"
 echo 'return { answer = 42 }' > "$T/lib/dmech/extra.lua"
 out=$(DMECH_PATH="$T/lib:$DMECH_PATH" "$D" -e 'print(require("dmech.extra").answer)' 2>&1); is "$out" "42" "DMECH_PATH is searched for dmech modules"
-out=$(DMECH_PATH= "$D" -e 'print(type(dm.help))' 2>&1); is "$out" "function" "compiled-in directories found without DMECH_PATH"
+out=$(DMECH_PATH= "$D" -e 'print(type(dm.help))' 2>&1); is "$out" "function" "the build tree's dmech finds the source lua/ without DMECH_PATH"
+# nothing of the source or build tree is compiled in: the same binary
+# outside its build tree (no dmech-uninstalled.path beside it) searches only
+# the installed directory
+mkdir -p "$T/bin"
+cp "$D" "$T/bin/dmech"
+out=$(DMECH_PATH= "$T/bin/dmech" -e 'print(package.path)' 2>&1)
+case "$out" in
+  *"$DMECH_SRCDIR/lua/"*) ok 1 "a copy outside the build tree does not search it";
+    printf '%s\n' "$out" | head -3 | sed 's/^/#   /';;
+  *) ok 0 "a copy outside the build tree does not search it";;
+esac
+out=$(DMECH_PATH="$DMECH_SRCDIR/lua" "$T/bin/dmech" -e 'print(type(dm.help))' 2>&1)
+is "$out" "function" "the copy works with DMECH_PATH"
 
 out=$(printf '1 + 1\n' | "$D" -i -e "_PROMPT='' _PROMPT2=''" 2>&1); like "$out" "^2$" "-i with piped stdin runs the REPL"
 out=$(printf 'print(7)\n' | "$D" -e "_PROMPT='P> '" -i 2>&1); like "$out" "P> 7" "prompt from _PROMPT on a non-terminal"
