@@ -82,17 +82,14 @@ size_t dm_expr_ctx_size(const dm_expr_ctx *ctx) { return ctx->n; }
  * hash-consing
  * =================================================================== */
 
-#define mix64 dm_expr__mix64
-#define dbits dm_expr__dbits
-
 static uint64_t node_hash(const dm_expr_ctx *ctx, int op, int32_t a,
                           int32_t b, int32_t c)
 {
   uint64_t h = (uint64_t)op * 0x9e3779b97f4a7c15ULL;
   if (op == DM_EXPR_CONST)
-    return mix64(h ^ dbits(ctx->cval[a]));
-  h = mix64(h ^ (uint32_t)a);
-  h = mix64(h ^ ((uint64_t)(uint32_t)b << 32 | (uint32_t)c));
+    return dm_expr__mix64(h ^ dm_expr__dbits(ctx->cval[a]));
+  h = dm_expr__mix64(h ^ (uint32_t)a);
+  h = dm_expr__mix64(h ^ ((uint64_t)(uint32_t)b << 32 | (uint32_t)c));
   return h;
 }
 
@@ -102,7 +99,7 @@ static int node_equal(const dm_expr_ctx *ctx, const dm_node *nd, int op,
   if (nd->op != op)
     return 0;
   if (op == DM_EXPR_CONST)
-    return dbits(ctx->cval[nd->a]) == dbits(ctx->cval[a]);
+    return dm_expr__dbits(ctx->cval[nd->a]) == dm_expr__dbits(ctx->cval[a]);
   return nd->a == a && nd->b == b && nd->c == c;
 }
 
@@ -318,9 +315,6 @@ dm_expr dm_expr_param(dm_expr_ctx *ctx, const char *name)
  * =================================================================== */
 
 #define K(x) dm_expr_const(ctx, (x))
-#define isc dm_expr__isc
-#define check2 dm_expr__check2
-
 
 /* x^n exactly as the tape and the native code compute it. */
 double dm_expr__powi_value(double x, int n);
@@ -331,10 +325,10 @@ double dm_expr__powi_value(double x, int n)
 
 dm_expr dm_expr_pow(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {
-  if (!check2(ctx, a, b))
+  if (!dm_expr__check2(ctx, a, b))
     return DM_EXPR_NONE;
   double ca, cb;
-  int ka = isc(ctx, a, &ca), kb = isc(ctx, b, &cb);
+  int ka = dm_expr__isc(ctx, a, &ca), kb = dm_expr__isc(ctx, b, &cb);
   if (ka && kb)
     return K(pow(ca, cb));
   if (kb) {
@@ -401,12 +395,12 @@ dm_expr dm_expr_unary(dm_expr_ctx *ctx, int op, dm_expr a)
   if (op < DM_EXPR_NEG || op > DM_EXPR_SIGN)
     return dm_expr__fail(ctx, DM_EINVAL, "expression: %s is not a unary "
                          "operation", dm_expr_op_name(op));
-  if (!check2(ctx, a, a))
+  if (!dm_expr__check2(ctx, a, a))
     return DM_EXPR_NONE;
   if (op == DM_EXPR_NEG)
     return dm_expr_neg(ctx, a);
   double c;
-  if (isc(ctx, a, &c))
+  if (dm_expr__isc(ctx, a, &c))
     return K(dm_expr_unary_value(op, c));
   const dm_node *nd = &ctx->node[a];
   switch (op) {
@@ -433,7 +427,7 @@ dm_expr dm_expr_unary(dm_expr_ctx *ctx, int op, dm_expr a)
 static dm_expr compare(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
 {
   double ca, cb;
-  if (isc(ctx, a, &ca) && isc(ctx, b, &cb))
+  if (dm_expr__isc(ctx, a, &ca) && dm_expr__isc(ctx, b, &cb))
     return K(dm_expr_binary_value(op, ca, cb));
   if (op == DM_EXPR_EQ || op == DM_EXPR_NE)
     return cons_comm(ctx, op, a, b);
@@ -445,7 +439,7 @@ dm_expr dm_expr_binary(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
   if (op < DM_EXPR_ADD || op > DM_EXPR_NE)
     return dm_expr__fail(ctx, DM_EINVAL, "expression: %s is not a binary "
                          "operation", dm_expr_op_name(op));
-  if (!check2(ctx, a, b))
+  if (!dm_expr__check2(ctx, a, b))
     return DM_EXPR_NONE;
   switch (op) {
   case DM_EXPR_ADD: return dm_expr_add(ctx, a, b);
@@ -455,7 +449,7 @@ dm_expr dm_expr_binary(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
   case DM_EXPR_POW: return dm_expr_pow(ctx, a, b);
   case DM_EXPR_ATAN2: {
     double ca, cb;
-    if (isc(ctx, a, &ca) && isc(ctx, b, &cb))
+    if (dm_expr__isc(ctx, a, &ca) && dm_expr__isc(ctx, b, &cb))
       return K(atan2(ca, cb));
     return cons(ctx, op, a, b, -1);
   }
@@ -466,10 +460,10 @@ dm_expr dm_expr_binary(dm_expr_ctx *ctx, int op, dm_expr a, dm_expr b)
 
 dm_expr dm_expr_select(dm_expr_ctx *ctx, dm_expr cond, dm_expr a, dm_expr b)
 {
-  if (!check2(ctx, cond, a) || !check2(ctx, a, b))
+  if (!dm_expr__check2(ctx, cond, a) || !dm_expr__check2(ctx, a, b))
     return DM_EXPR_NONE;
   double c;
-  if (isc(ctx, cond, &c))
+  if (dm_expr__isc(ctx, cond, &c))
     return c != 0 ? a : b;   /* NaN != 0: like the tape */
   if (a == b)
     return a;

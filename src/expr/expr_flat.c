@@ -12,18 +12,6 @@
 
 #define EXP_LIMIT ((int64_t)1 << 30)
 
-#define mix64 dm_expr__mix64
-#define dbits dm_expr__dbits
-
-#define isc dm_expr__isc
-#define sumlike dm_expr__sumlike
-#define grow dm_expr__grow
-#define new_el dm_expr__new_el
-#define flatten_sum dm_expr__flatten_sum
-#define flatten_prod dm_expr__flatten_prod
-#define hel dm_expr__hel
-#define hfin dm_expr__hfin
-
 enum { ADD = DM_EXPR_ADD, SUB = DM_EXPR_SUB, MUL = DM_EXPR_MUL,
        DIV = DM_EXPR_DIV, NEG = DM_EXPR_NEG, POWI = DM_EXPR_POWI };
 
@@ -42,7 +30,6 @@ int dm_expr__sumlike(const dm_expr_ctx *ctx, dm_expr e)
 /* {==================================================================
  * flattening
  * =================================================================== */
-
 
 int dm_expr__grow(void *pp, size_t *cap, size_t need, size_t size)
 {
@@ -63,7 +50,7 @@ int dm_expr__grow(void *pp, size_t *cap, size_t need, size_t size)
 dm_nel *dm_expr__new_el(dm_expr_ctx *ctx, dm_flat *f)
 {
   if (f->n >= ctx->nelcap[f->w] &&
-      grow(&ctx->nel[f->w], &ctx->nelcap[f->w], f->n + 1, sizeof(dm_nel)))
+      dm_expr__grow(&ctx->nel[f->w], &ctx->nelcap[f->w], f->n + 1, sizeof(dm_nel)))
     return NULL;
   dm_nel *x = &ctx->nel[f->w][f->n++];
   memset(x, 0, sizeof *x);
@@ -73,7 +60,7 @@ dm_nel *dm_expr__new_el(dm_expr_ctx *ctx, dm_flat *f)
 static inline int walk_push(dm_expr_ctx *ctx, size_t *ns, dm_expr e, int64_t ex)
 {
   if (*ns >= ctx->walkcap &&
-      grow(&ctx->walk, &ctx->walkcap, *ns + 1, sizeof(dm_nwalk)))
+      dm_expr__grow(&ctx->walk, &ctx->walkcap, *ns + 1, sizeof(dm_nwalk)))
     return -1;
   ctx->walk[*ns].node = e;
   ctx->walk[*ns].e = ex;
@@ -91,7 +78,7 @@ static double split(const dm_expr_ctx *ctx, dm_expr e, int32_t *key,
     e = ctx->node[e].a;
   }
   const dm_node *nd = &ctx->node[e];
-  if ((nd->op == MUL || nd->op == DIV) && isc(ctx, nd->a, &v)) {
+  if ((nd->op == MUL || nd->op == DIV) && dm_expr__isc(ctx, nd->a, &v)) {
     *key = nd->b;
     *kind = nd->op == MUL ? DM_NE_PLAIN : DM_NE_RECIP;
     return c * v;
@@ -121,7 +108,7 @@ int dm_expr__flatten_sum(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int s, int src
         return -1;
       continue;
     case NEG:
-      if (sumlike(ctx, nd.a)) {
+      if (dm_expr__sumlike(ctx, nd.a)) {
         if (walk_push(ctx, &ns, nd.a, -sg))
           return -1;
         continue;
@@ -149,7 +136,7 @@ int dm_expr__flatten_sum(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int s, int src
       E[i].c += c;
       continue;
     }
-    dm_nel *y = new_el(ctx, f);
+    dm_nel *y = dm_expr__new_el(ctx, f);
     if (y == NULL)
       return -1;
     y->key = key;
@@ -232,7 +219,7 @@ int dm_expr__flatten_prod(dm_expr_ctx *ctx, dm_flat *f, dm_expr e, int64_t ex,
       E[i].k = (int32_t)s;
       continue;
     }
-    dm_nel *y = new_el(ctx, f);
+    dm_nel *y = dm_expr__new_el(ctx, f);
     if (y == NULL)
       return -1;
     y->key = x;
@@ -256,14 +243,14 @@ uint64_t dm_expr__hel(const dm_nel *x, int prod)
   uint64_t h = (uint64_t)(uint32_t)x->key * 0x9e3779b97f4a7c15ULL ^
                (uint64_t)(uint32_t)x->k * 0xc2b2ae3d27d4eb4fULL;
   if (!prod)
-    h ^= mix64(dbits(canon(x->c)) + 0x165667b19e3779f9ULL);
-  return mix64(h);
+    h ^= dm_expr__mix64(dm_expr__dbits(canon(x->c)) + 0x165667b19e3779f9ULL);
+  return dm_expr__mix64(h);
 }
 
 /* Hash of a multiset from the sum of its element hashes. */
 uint64_t dm_expr__hfin(uint64_t s, size_t n, int prod)
 {
-  return mix64(s + (uint64_t)n * 0x27d4eb2f165667c5ULL +
+  return dm_expr__mix64(s + (uint64_t)n * 0x27d4eb2f165667c5ULL +
                (prod ? 0x94d049bb133111ebULL : 0));
 }
 
@@ -274,7 +261,7 @@ static int cmp_el(const void *p, const void *q)
     return x->key < y->key ? -1 : 1;
   if (x->k != y->k)
     return x->k < y->k ? -1 : 1;
-  uint64_t a = dbits(canon(x->c)), b = dbits(canon(y->c));
+  uint64_t a = dm_expr__dbits(canon(x->c)), b = dm_expr__dbits(canon(y->c));
   return (a > b) - (a < b);
 }
 
@@ -283,14 +270,14 @@ static int same(dm_expr_ctx *ctx, dm_expr e, int prod, const dm_nel *E,
                 size_t n)
 {
   dm_flat f = { 1, 0, prod ? 1.0 : 0.0, 1.0, 0 };
-  int r = prod ? flatten_prod(ctx, &f, e, 1, 0, 0)
-               : flatten_sum(ctx, &f, e, 1, 0, 0);
+  int r = prod ? dm_expr__flatten_prod(ctx, &f, e, 1, 0, 0)
+               : dm_expr__flatten_sum(ctx, &f, e, 1, 0, 0);
   if (r != 0)
     return 0;
   if (prod && (f.c != 1 || f.d != 1))
     return 0;
   if (!prod && f.hasc && f.c != 0) {
-    dm_nel *y = new_el(ctx, &f);
+    dm_nel *y = dm_expr__new_el(ctx, &f);
     if (y == NULL)
       return 0;
     y->key = -1;
@@ -299,7 +286,7 @@ static int same(dm_expr_ctx *ctx, dm_expr e, int prod, const dm_nel *E,
   }
   if (f.n != n)
     return 0;
-  if (grow(&ctx->nel[1], &ctx->nelcap[1], 2 * n, sizeof(dm_nel)))
+  if (dm_expr__grow(&ctx->nel[1], &ctx->nelcap[1], 2 * n, sizeof(dm_nel)))
     return 0;
   dm_nel *A = ctx->nel[1], *B = A + n;
   for (size_t i = 0; i < n; i++) {

@@ -42,18 +42,6 @@
 #define EXP_LIMIT ((int64_t)1 << 30)
 
 #define K(x) dm_expr__k(ctx, (x))
-#define nlen dm_expr__nlen
-#define isc dm_expr__isc
-#define sumlike dm_expr__sumlike
-#define grow dm_expr__grow
-#define new_el dm_expr__new_el
-#define flatten_sum dm_expr__flatten_sum
-#define flatten_prod dm_expr__flatten_prod
-#define hel dm_expr__hel
-#define hfin dm_expr__hfin
-#define probe dm_expr__probe
-#define reg dm_expr__reg
-#define check2 dm_expr__check2
 
 enum { ADD = DM_EXPR_ADD, SUB = DM_EXPR_SUB, MUL = DM_EXPR_MUL,
        DIV = DM_EXPR_DIV, NEG = DM_EXPR_NEG, POWI = DM_EXPR_POWI };
@@ -77,7 +65,7 @@ size_t dm_expr__nlen(const dm_expr_ctx *ctx, dm_expr e, int prod)
   double c;
   while (ctx->node[e].op == NEG)
     e = ctx->node[e].a;
-  if (!prod && ctx->node[e].op == MUL && isc(ctx, ctx->node[e].a, &c))
+  if (!prod && ctx->node[e].op == MUL && dm_expr__isc(ctx, ctx->node[e].a, &c))
     e = ctx->node[e].b;          /* c*(sum): the sum's terms */
   while (ctx->node[e].op == NEG)
     e = ctx->node[e].a;
@@ -152,26 +140,27 @@ static dm_expr build(dm_expr_ctx *ctx, dm_nel *E, size_t n, size_t k, int prod)
     return next_node(ctx, &E[0], prod, &op);
   uint64_t tot = 0, ha = 0;
   for (size_t i = 0; i < n; i++) {
-    E[i].h = hel(&E[i], prod);
+    E[i].h = dm_expr__hel(&E[i], prod);
     tot += E[i].h;
     if (i < k)
       ha += E[i].h;
   }
-  uint64_t hn = hfin(tot, n, prod);
-  dm_expr r = probe(ctx, hn, prod, E, n);
+  uint64_t hn = dm_expr__hfin(tot, n, prod);
+  dm_expr r = dm_expr__probe(ctx, hn, prod, E, n);
   if (r != DM_EXPR_NONE)
     return r;
   if (k > 0 && k < n) {               /* both operands' parts exist? */
     dm_expr A = k == 1 ? next_node(ctx, &E[0], prod, &op)
-                       : probe(ctx, hfin(ha, k, prod), prod, E, k);
+                       : dm_expr__probe(ctx, dm_expr__hfin(ha, k, prod), prod, E, k);
     dm_expr B = DM_EXPR_NONE;
     op = prod ? MUL : ADD;
     if (A != DM_EXPR_NONE)
       B = n - k == 1 ? next_node(ctx, &E[k], prod, &op)
-                     : probe(ctx, hfin(tot - ha, n - k, prod), prod, E + k, n - k);
+                     : dm_expr__probe(ctx, dm_expr__hfin(tot - ha, n - k, prod), prod, E + k,
+                                      n - k);
     if (B != DM_EXPR_NONE) {
       r = node2(ctx, op, A, B, n);
-      return reg(ctx, hn, r) ? DM_EXPR_NONE : r;
+      return dm_expr__reg(ctx, hn, r) ? DM_EXPR_NONE : r;
     }
   }
   /* the longest existing prefix, then one element at a time */
@@ -179,7 +168,7 @@ static dm_expr build(dm_expr_ctx *ctx, dm_nel *E, size_t n, size_t k, int prod)
   uint64_t hp = tot - E[n - 1].h;
   r = DM_EXPR_NONE;
   for (; j >= 2; j--) {
-    if ((r = probe(ctx, hfin(hp, j, prod), prod, E, j)) != DM_EXPR_NONE)
+    if ((r = dm_expr__probe(ctx, dm_expr__hfin(hp, j, prod), prod, E, j)) != DM_EXPR_NONE)
       break;
     hp -= E[j - 1].h;
   }
@@ -194,7 +183,7 @@ static dm_expr build(dm_expr_ctx *ctx, dm_nel *E, size_t n, size_t k, int prod)
     if (t == DM_EXPR_NONE)
       return DM_EXPR_NONE;
     r = node2(ctx, op, r, t, j + 1);
-    if (reg(ctx, hfin(hp, j + 1, prod), r))
+    if (dm_expr__reg(ctx, dm_expr__hfin(hp, j + 1, prod), r))
       return DM_EXPR_NONE;
   }
   return r;
@@ -232,7 +221,7 @@ static dm_expr long_sum(dm_expr_ctx *ctx, dm_expr a, dm_expr b, int sb,
   if (la < lb || lb > NORM_LIMIT)
     return node2(ctx, sb > 0 ? ADD : SUB, a, b, la + lb);
   dm_flat f = { 0, 0, 0, 1, 0 };
-  if (flatten_sum(ctx, &f, b, sb, 1, 0))
+  if (dm_expr__flatten_sum(ctx, &f, b, sb, 1, 0))
     return oom(ctx);
   dm_expr r = a;
   for (size_t i = 0; i < f.n && r != DM_EXPR_NONE; i++) {
@@ -319,13 +308,13 @@ static dm_expr finish_sum(dm_expr_ctx *ctx, dm_flat *f);
 /* sa*a + sb*b (b may be DM_EXPR_NONE: sa*a). */
 static dm_expr norm_sum(dm_expr_ctx *ctx, dm_expr a, int sa, dm_expr b, int sb)
 {
-  size_t la = nlen(ctx, a, 0), lb = b != DM_EXPR_NONE ? nlen(ctx, b, 0) : 0;
+  size_t la = dm_expr__nlen(ctx, a, 0), lb = b != DM_EXPR_NONE ? dm_expr__nlen(ctx, b, 0) : 0;
   if (la > NORM_LIMIT || lb > NORM_LIMIT)
     return long_sum(ctx, a, b, sb, la, lb);
   dm_flat f = { 0, 0, 0, 1, 0 };
   int lin = la + lb <= 16;              /* short: merge by linear search */
-  if (flatten_sum(ctx, &f, a, sa, 0, 0) ||
-      (b != DM_EXPR_NONE && flatten_sum(ctx, &f, b, sb, 1, lin)) ||
+  if (dm_expr__flatten_sum(ctx, &f, a, sa, 0, 0) ||
+      (b != DM_EXPR_NONE && dm_expr__flatten_sum(ctx, &f, b, sb, 1, lin)) ||
       (!lin && merge_like(ctx, &f)))
     return oom(ctx);
   return finish_sum(ctx, &f);
@@ -335,9 +324,9 @@ dm_expr dm_expr__sum_n(dm_expr_ctx *ctx, size_t k, const dm_expr *t)
 {
   size_t tot = 0;
   for (size_t i = 0; i < k; i++) {
-    if (!check2(ctx, t[i], t[i]))
+    if (!dm_expr__check2(ctx, t[i], t[i]))
       return DM_EXPR_NONE;
-    tot += nlen(ctx, t[i], 0);
+    tot += dm_expr__nlen(ctx, t[i], 0);
   }
   if (k == 0)
     return K(0.0);
@@ -351,7 +340,7 @@ dm_expr dm_expr__sum_n(dm_expr_ctx *ctx, size_t k, const dm_expr *t)
   }
   dm_flat f = { 0, 0, 0, 1, 0 };
   for (size_t i = 0; i < k; i++)
-    if (flatten_sum(ctx, &f, t[i], 1, i == 0 ? 0 : 1, 0))
+    if (dm_expr__flatten_sum(ctx, &f, t[i], 1, i == 0 ? 0 : 1, 0))
       return oom(ctx);
   if (merge_like(ctx, &f))
     return oom(ctx);
@@ -372,10 +361,10 @@ static dm_expr finish_sum(dm_expr_ctx *ctx, dm_flat *pf)
     int expanded = 0, lin = f.n <= 16;
     for (size_t i = 0; i < f.n; i++) {
       dm_nel x = ctx->nel[0][i];
-      if (x.k == DM_NE_PLAIN && (x.c == 1 || x.c == -1) && sumlike(ctx, x.key)) {
+      if (x.k == DM_NE_PLAIN && (x.c == 1 || x.c == -1) && dm_expr__sumlike(ctx, x.key)) {
         ctx->nel[0][i].c = 0;
         expanded = 1;
-        if (flatten_sum(ctx, &f, x.key, x.c > 0 ? 1 : -1, x.src, lin))
+        if (dm_expr__flatten_sum(ctx, &f, x.key, x.c > 0 ? 1 : -1, x.src, lin))
           return oom(ctx);
       }
     }
@@ -420,7 +409,7 @@ static dm_expr build_sum(dm_expr_ctx *ctx, size_t n, size_t k, int hc,
 {
   dm_nel *E = ctx->nel[0];
   if (hc) {                    /* a's constant ends a's part, else the sum */
-    dm_nel *y = new_el(ctx, f);
+    dm_nel *y = dm_expr__new_el(ctx, f);
     if (y == NULL)
       return oom(ctx);
     E = ctx->nel[0];
@@ -474,7 +463,7 @@ static dm_expr raw_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
   dm_expr r;
   if (b != DM_EXPR_NONE)
     r = node2(ctx, eb > 0 ? MUL : DIV, a, b,
-              nlen(ctx, a, 1) + nlen(ctx, b, 1));
+              dm_expr__nlen(ctx, a, 1) + dm_expr__nlen(ctx, b, 1));
   else if (ea > INT32_MAX || ea < -INT32_MAX)
     return dm_expr__fail(ctx, DM_EINVAL, "expression: exponent too large");
   else
@@ -486,14 +475,14 @@ static dm_expr raw_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
 static dm_expr norm_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
                          int64_t eb, double c0)
 {
-  if (nlen(ctx, a, 1) > NORM_LIMIT ||
-      (b != DM_EXPR_NONE && nlen(ctx, b, 1) > NORM_LIMIT))
+  if (dm_expr__nlen(ctx, a, 1) > NORM_LIMIT ||
+      (b != DM_EXPR_NONE && dm_expr__nlen(ctx, b, 1) > NORM_LIMIT))
     return raw_prod(ctx, a, ea, b, eb, c0);
   dm_flat f = { 0, 0, c0, 1, 0 };
   int s = ea > EXP_LIMIT || ea < -EXP_LIMIT ? 1
-                                            : flatten_prod(ctx, &f, a, ea, 0, 0);
+                                            : dm_expr__flatten_prod(ctx, &f, a, ea, 0, 0);
   if (s == 0 && b != DM_EXPR_NONE)
-    s = flatten_prod(ctx, &f, b, eb, 1, 1);
+    s = dm_expr__flatten_prod(ctx, &f, b, eb, 1, 1);
   if (s < 0)
     return oom(ctx);
   if (s > 0)
@@ -522,11 +511,11 @@ static dm_expr norm_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
   if (n == 1 && E[0].k == 1 && d == 1) {
     if (c == 1)
       return E[0].key;
-    if (c == -1 && sumlike(ctx, E[0].key))    /* -(x - y) -> y - x */
+    if (c == -1 && dm_expr__sumlike(ctx, E[0].key))    /* -(x - y) -> y - x */
       return norm_sum(ctx, E[0].key, -1, DM_EXPR_NONE, 0);
   }
   /* numerator E[0..nn), denominator (exponents negated) after it */
-  if (grow(&ctx->nel[0], &ctx->nelcap[0], 2 * n, sizeof(dm_nel)))
+  if (dm_expr__grow(&ctx->nel[0], &ctx->nelcap[0], 2 * n, sizeof(dm_nel)))
     return oom(ctx);
   E = ctx->nel[0];
   dm_nel *D = E + n;
@@ -568,39 +557,39 @@ static dm_expr norm_prod(dm_expr_ctx *ctx, dm_expr a, int64_t ea, dm_expr b,
 
 dm_expr dm_expr_add(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {
-  return check2(ctx, a, b) ? norm_sum(ctx, a, 1, b, 1) : DM_EXPR_NONE;
+  return dm_expr__check2(ctx, a, b) ? norm_sum(ctx, a, 1, b, 1) : DM_EXPR_NONE;
 }
 
 dm_expr dm_expr_sub(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {
-  return check2(ctx, a, b) ? norm_sum(ctx, a, 1, b, -1) : DM_EXPR_NONE;
+  return dm_expr__check2(ctx, a, b) ? norm_sum(ctx, a, 1, b, -1) : DM_EXPR_NONE;
 }
 
 dm_expr dm_expr_neg(dm_expr_ctx *ctx, dm_expr a)
 {
-  if (!check2(ctx, a, a))
+  if (!dm_expr__check2(ctx, a, a))
     return DM_EXPR_NONE;
   double c;
-  if (isc(ctx, a, &c))
+  if (dm_expr__isc(ctx, a, &c))
     return K(-c);
-  if (sumlike(ctx, a))
+  if (dm_expr__sumlike(ctx, a))
     return norm_sum(ctx, a, -1, DM_EXPR_NONE, 0);
   return norm_prod(ctx, a, 1, DM_EXPR_NONE, 0, -1.0);
 }
 
 dm_expr dm_expr_mul(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {
-  return check2(ctx, a, b) ? norm_prod(ctx, a, 1, b, 1, 1.0) : DM_EXPR_NONE;
+  return dm_expr__check2(ctx, a, b) ? norm_prod(ctx, a, 1, b, 1, 1.0) : DM_EXPR_NONE;
 }
 
 dm_expr dm_expr_div(dm_expr_ctx *ctx, dm_expr a, dm_expr b)
 {
-  return check2(ctx, a, b) ? norm_prod(ctx, a, 1, b, -1, 1.0) : DM_EXPR_NONE;
+  return dm_expr__check2(ctx, a, b) ? norm_prod(ctx, a, 1, b, -1, 1.0) : DM_EXPR_NONE;
 }
 
 dm_expr dm_expr_powi(dm_expr_ctx *ctx, dm_expr a, int n)
 {
-  if (!check2(ctx, a, a))
+  if (!dm_expr__check2(ctx, a, a))
     return DM_EXPR_NONE;
   if (n == 0)
     return K(1.0);

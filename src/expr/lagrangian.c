@@ -212,7 +212,6 @@ int dm_lag__compile_bundle(lag_builder *b, dm_bundle *p, size_t nout, const dm_e
                         sp->par_values, sp->native };
   return dm_bundle_compile(p, &src, nout, out, nin, blk, nblk, exact, b->err);
 }
-#define compile_bundle dm_lag__compile_bundle
 
 static int cmp_expr(const void *a, const void *b)
 {
@@ -375,7 +374,7 @@ int dm_lag__detect_structure(lag_builder *b, lag_data *d, const dm_expr *Lv,
   dm_lagrangian_spec tsp = *sp;
   tsp.native = DM_NATIVE_NEVER;       /* evaluated rarely: the tape will do */
   nb.sp = &tsp;
-  s = compile_bundle(&nb, &d->massp, nmout, mout, 2 * n, NULL, 0, 0);
+  s = dm_lag__compile_bundle(&nb, &d->massp, nmout, mout, 2 * n, NULL, 0, 0);
   if (s != DM_OK)
     return s;
   d->mass_possible = 1;
@@ -499,8 +498,8 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
   const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0, NULL }, { 1, DM_BLK_VEC, n, 1, 0, NULL },
                            { 2, DM_BLK_VEC, n, 1, 0, NULL }, { 3, DM_BLK_SYM, n, 1, 0, NULL },
                            { 4, DM_BLK_FULL, n, 1, 0, NULL }, { 5, DM_BLK_SYM, n, 1, 0, NULL } };
-  if ((s = compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+  if ((s = dm_lag__compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = dm_lag__compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
       (s = dm_lag__detect_structure(b, d, Lv, n * n, Lvv, d->pat.vq.nnz == 0, n * n, Lvv,
                                     flags)) != DM_OK)
     goto done;
@@ -513,8 +512,8 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0, NULL }, { 2, DM_BLK_VEC, n, 1, 0, NULL },
                              { 5, DM_BLK_SYM, n, 1, 0, NULL } };
     memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
-    if ((s = compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
-        (s = compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
+    if ((s = dm_lag__compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
+        (s = dm_lag__compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
       goto done;
   }
   dm_lag__select(d);
@@ -577,9 +576,9 @@ static int build_force(builder *b, lag_data *d)
   }
   free(J);
   if (s == DM_OK)
-    s = compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
+    s = dm_lag__compile_bundle(b, &d->force, n, out, 2 * n, blk, 3, 1);
   if (s == DM_OK)
-    s = compile_bundle(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
+    s = dm_lag__compile_bundle(b, &d->force_all, nall, out, 2 * n, blk, 3, 1);
   free(out);
   free(r);
   free(c);
@@ -612,9 +611,9 @@ static int build_constraints(builder *b, lag_data *d)
   if (s == DM_OK)
     s = dm_tape_optimize(b->ctx, nall, out, out, b->err);
   if (s == DM_OK)
-    s = compile_bundle(b, &d->constr, m + m * n, out, n, blk, 3, 1);
+    s = dm_lag__compile_bundle(b, &d->constr, m + m * n, out, n, blk, 3, 1);
   if (s == DM_OK)
-    s = compile_bundle(b, &d->constr_all, nall, out, n, blk, 3, 1);
+    s = dm_lag__compile_bundle(b, &d->constr_all, nall, out, n, blk, 3, 1);
   free(out);
   return s;
 }

@@ -29,8 +29,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define grow dm_expr__grow
-
 enum { K_OTHER = 0, K_SUM = 1, K_PROD = 2 };
 enum { ADD = DM_EXPR_ADD, SUB = DM_EXPR_SUB, MUL = DM_EXPR_MUL,
        DIV = DM_EXPR_DIV, NEG = DM_EXPR_NEG, POWI = DM_EXPR_POWI };
@@ -123,7 +121,7 @@ static int node_kind(const dm_expr_ctx *ctx, dm_expr x)
 
 static int push(opt *o, size_t *ns, dm_expr x, int64_t e)
 {
-  if (grow(&o->stk, &o->capstk, *ns + 1, sizeof *o->stk))
+  if (dm_expr__grow(&o->stk, &o->capstk, *ns + 1, sizeof *o->stk))
     return -1;
   o->stk[*ns].node = x;
   o->stk[*ns].e = e;
@@ -139,7 +137,7 @@ static int add_fac(opt *o, size_t off, dm_expr x, int64_t e)
       o->facs[i].e += (int32_t)e;
       return 0;
     }
-  if (grow(&o->facs, &o->capfacs, o->nfacs + 1, sizeof *o->facs))
+  if (dm_expr__grow(&o->facs, &o->capfacs, o->nfacs + 1, sizeof *o->facs))
     return -1;
   o->facs[o->nfacs].atom = p;
   o->facs[o->nfacs++].e = (int32_t)e;
@@ -204,7 +202,7 @@ static int add_monomial(opt *o, dm_expr y, double s, int apart, size_t base)
     if (o->facs[i].e != 0)
       o->facs[n++] = o->facs[i];
   o->nfacs = n;
-  if (grow(&o->terms, &o->capterms, o->nterms + 1, sizeof *o->terms))
+  if (dm_expr__grow(&o->terms, &o->capterms, o->nterms + 1, sizeof *o->terms))
     return -1;
   o->terms[o->nterms++] = (term){ c, off, n - off };
   return 0;
@@ -248,7 +246,7 @@ static int build_ir(opt *o, long p)
         return -1;
     }
     if (cst != 0) {
-      if (grow(&o->terms, &o->capterms, o->nterms + 1, sizeof *o->terms))
+      if (dm_expr__grow(&o->terms, &o->capterms, o->nterms + 1, sizeof *o->terms))
         return -1;
       o->terms[o->nterms++] = (term){ cst, o->nfacs, 0 };
     }
@@ -431,9 +429,9 @@ static long sum_put(opt *o, uint64_t h, const mterm *T, size_t nt, sv val)
   size_t nf = 0;
   for (size_t i = 0; i < nt; i++)
     nf += T[i].n;
-  if (grow(&o->sums, &o->capsums, o->nsums + 1, sizeof *o->sums) ||
-      grow(&o->rterm, &o->caprterm, o->nrterm + nt, sizeof *o->rterm) ||
-      grow(&o->rfac, &o->caprfac, o->nrfac + nf, sizeof *o->rfac))
+  if (dm_expr__grow(&o->sums, &o->capsums, o->nsums + 1, sizeof *o->sums) ||
+      dm_expr__grow(&o->rterm, &o->caprterm, o->nrterm + nt, sizeof *o->rterm) ||
+      dm_expr__grow(&o->rfac, &o->caprfac, o->nrfac + nf, sizeof *o->rfac))
     return -1;                         /* (only a missed reuse) */
   if (2 * (o->nsums + 1) > o->stabcap) {
     size_t cap = o->stabcap ? 2 * o->stabcap : 256;

@@ -92,7 +92,7 @@ int dm_integrator_reversal(dm_integrator *I, double h, long n, const double *q0,
   return DM_OK;
 }
 
-double dm_order_fit(const double *h, const double *err, size_t k)
+double dm_integrator_order_fit(const double *h, const double *err, size_t k)
 {
   double sx = 0, sy = 0, sxx = 0, sxy = 0, den;
   size_t i;
@@ -178,7 +178,7 @@ int dm_integrator_order_estimate(const dm_system *sys, const char *method,
       err[i] = errs[i];
   }
   if (st == DM_OK && order)
-    *order = dm_order_fit(h, errs, k);
+    *order = dm_integrator_order_fit(h, errs, k);
   free(buf);
   return st;
 }

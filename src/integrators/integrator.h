@@ -295,7 +295,7 @@ int dm_integrator_reversal(dm_integrator *I, double h, long n, const double *q0,
                            const double *p0, double *dev, dm_err *e);
 /* Least-squares slope of log(err) against log(h) (k >= 2 points, all > 0);
  * NaN if the data are unusable. */
-double dm_order_fit(const double *h, const double *err, size_t k);
+double dm_integrator_order_fit(const double *h, const double *err, size_t k);
 /* Empirical order: integrate from (q0, p0) to time T with each step h[i]
  * (T/h[i] rounded to whole steps, h adjusted), compare with the reference
  * (qref, pref) at T (NULL: computed with a high-order method and a small

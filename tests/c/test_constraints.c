@@ -120,7 +120,7 @@ static void manifold_and_order(void)
         e2 += (qq[k] - qr[k]) * (qq[k] - qr[k]) + (pp[k] - vr[k]) * (pp[k] - vr[k]);
       err[j] = sqrt(e2);
     }
-    ord = dm_order_fit(h, err, 4);
+    ord = dm_integrator_order_fit(h, err, 4);
     tap_ok(fabs(ord - cm[i].order) <= 0.15,
            "%s agrees with the spherical-coordinate solution at order %.3f (want %d; errors %.2e .. %.2e)",
            label(&cm[i], buf, sizeof buf), ord, cm[i].order, err[0], err[3]);

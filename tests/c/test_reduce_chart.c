@@ -329,7 +329,7 @@ static void agreement(void)
     }
   }
   for (c = 0; c < 2; c++) {
-    double sl = dm_order_fit(hs, err[c], 3);
+    double sl = dm_integrator_order_fit(hs, err[c], 3);
     tap_ok(fabs(sl - 4) <= 0.2, "%s vs cylindrical chart, positions q1, q2 at T = 1 (theta "
            "reconstructed): difference shrinks with order %.2f (%.2g, %.2g, %.2g)",
            c ? "bob 2 polar" : "bob 1 polar", sl, err[c][0], err[c][1], err[c][2]);

@@ -181,7 +181,7 @@ static void constrained(void)
       err[k] = fmax(fabs(ya[0] - xa[0]), fmax(fabs(ya[2] - xa[1]), fabs(ya[3] - xa[2])));
       dm_integrator_free(Cy);
     }
-    sl = dm_order_fit(hs, err, 3);
+    sl = dm_integrator_order_fit(hs, err, 3);
     tap_ok(fabs(sl - 4) <= 0.3, "constrained R^3 x R^3 RSPRK vs cylindrical RSPRK (Lobatto 3): "
            "difference at T = 1 shrinks with order %.2f (%.2g, %.2g, %.2g)", sl, err[0], err[1], err[2]);
   }

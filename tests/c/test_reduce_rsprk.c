@@ -166,7 +166,7 @@ static void orders_and_defect(void)
       dm_integrator_run(I, 0, x, s, hs[k], n, n, NULL, NULL, NULL, NULL);
       err[k] = fmax(vdiff(x, xr, 3), vdiff(s, sr, 3));
     }
-    slope = dm_order_fit(hs, err, 4);
+    slope = dm_integrator_order_fit(hs, err, 4);
     tap_ok(fabs(slope - 2 * stages) <= 0.1, "RSPRK Gauss s = %d: fitted order %.3f (errors %.2g .. %.2g)",
            stages, slope, err[0], err[3]);
     dm_routh_symplecticity_defect(I, 0.05, x0, s0, &def, &e);
