@@ -3,11 +3,13 @@
  * operations. */
 #include <config.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "lie/lie_impl.h"
+#include "core/numfmt.h"
 
 /* {==== construction ===================================================== */
 
@@ -192,6 +194,164 @@ int dm_lie_group_equal(const dm_lie_group *G, const dm_lie_group *H)
   return 1;
 }
 
+/* "SO3" | "SE3" | "SO2" | "SE2" | "R<n>" | "T<n>" */
+static dm_lie_group *parse_one(const char *s, size_t len, dm_err *e)
+{
+  char buf[16];
+  if (len == 0 || len >= sizeof buf) {
+    dm_err_set(e, DM_EINVAL, "Lie group name: cannot read '%.*s' (expected SO2, SO3, SE2, SE3, "
+               "R<n> or T<n>)", (int)len, s);
+    return NULL;
+  }
+  memcpy(buf, s, len);
+  buf[len] = '\0';
+  if (strcmp(buf, "SO3") == 0)
+    return dm_lie_so3(e);
+  if (strcmp(buf, "SE3") == 0)
+    return dm_lie_se3(e);
+  if (strcmp(buf, "SO2") == 0)
+    return dm_lie_so2(e);
+  if (strcmp(buf, "SE2") == 0)
+    return dm_lie_se2(e);
+  if ((buf[0] == 'R' || buf[0] == 'T') && buf[1] >= '1' && buf[1] <= '9') {
+    char *end;
+    unsigned long n = strtoul(buf + 1, &end, 10);
+    if (*end == '\0')
+      return buf[0] == 'R' ? dm_lie_rn(n, e) : dm_lie_torus(n, e);
+  }
+  dm_err_set(e, DM_EINVAL, "Lie group name: cannot read '%s' (expected SO2, SO3, SE2, SE3, "
+             "R<n> or T<n>)", buf);
+  return NULL;
+}
+
+dm_lie_group *dm_lie_group_parse(const char *name, dm_err *e)
+{
+  dm_lie_group *fac[DM_LIE_FAC_MAX], *G = NULL;
+  size_t k = 0, i;
+  const char *s = name;
+  if (name == NULL) {
+    dm_err_set(e, DM_EINVAL, "Lie group name: none given");
+    return NULL;
+  }
+  for (;;) {
+    const char *x = strchr(s, 'x');
+    size_t len = x ? (size_t)(x - s) : strlen(s);
+    if (k == DM_LIE_FAC_MAX) {
+      dm_err_set(e, DM_EINVAL, "Lie group name '%s': more than %d factors", name, DM_LIE_FAC_MAX);
+      goto out;
+    }
+    if ((fac[k] = parse_one(s, len, e)) == NULL)
+      goto out;
+    k++;
+    if (x == NULL)
+      break;
+    s = x + 1;
+  }
+  G = k == 1 ? fac[--k] : dm_lie_product(k, (const dm_lie_group *const *)fac, e);
+out:
+  for (i = 0; i < k; i++)
+    dm_lie_group_free(fac[i]);
+  return G;
+}
+
+/* }====================================================================== */
+
+/* {==== description ====================================================== */
+
+typedef struct sbuf {
+  char *p;
+  size_t size, len;
+} sbuf;
+
+static void put(sbuf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+  __attribute__((format(printf, 2, 3)))
+#endif
+  ;
+static void put(sbuf *b, const char *fmt, ...)
+{
+  va_list ap;
+  int n;
+  va_start(ap, fmt);
+  n = dm_num_vsnprintf(b->p ? b->p + (b->len < b->size ? b->len : b->size) : NULL,
+                       b->len < b->size ? b->size - b->len : 0, fmt, ap);
+  va_end(ap);
+  if (n > 0)
+    b->len += (size_t)n;
+}
+
+static void put_vec(sbuf *b, const double *x, size_t n)
+{
+  size_t i;
+  put(b, "(");
+  for (i = 0; i < n; i++)
+    put(b, "%s%.6g", i ? ", " : "", x[i] == 0.0 ? 0.0 : x[i]);
+  put(b, ")");
+}
+
+static void put_rotation(sbuf *b, const double *R)
+{
+  double w[3], th;
+  dm_so3_log(R, w);
+  th = sqrt(dm_v3_dot(w, w));
+  if (th == 0.0) {
+    put(b, "rotation 0");
+    return;
+  }
+  w[0] /= th, w[1] /= th, w[2] /= th;
+  put(b, "rotation %.6g about ", th);
+  put_vec(b, w, 3);
+}
+
+static void describe1(const dm_lie_group *G, const double *g, sbuf *b)
+{
+  size_t i;
+  switch (G->kind) {
+  case DM_LIE_SO3:
+    put_rotation(b, g);
+    put(b, " [");
+    for (i = 0; i < 9; i++)   /* entries below 1e-14 (rounded zeros) print as 0 */
+      put(b, "%s%.4g", i == 0 ? "" : i % 3 == 0 ? "; " : " ", fabs(g[i]) < 1e-14 ? 0.0 : g[i]);
+    put(b, "]");
+    break;
+  case DM_LIE_SE3:
+    put_rotation(b, g);
+    put(b, ", translation ");
+    put_vec(b, g + 9, 3);
+    break;
+  case DM_LIE_SO2:
+    put(b, "angle %.6g", g[0]);
+    break;
+  case DM_LIE_SE2:
+    put(b, "angle %.6g, translation ", g[0]);
+    put_vec(b, g + 1, 2);
+    break;
+  case DM_LIE_TN:
+    put(b, "angles ");
+    put_vec(b, g, G->n);
+    break;
+  default:
+    put_vec(b, g, G->nq);
+    break;
+  }
+}
+
+int dm_lie_describe(const dm_lie_group *G, const double *g, char *buf, size_t size)
+{
+  sbuf b = {buf, size, 0};
+  size_t i;
+  if (buf != NULL && size > 0)
+    buf[0] = '\0';
+  if (G->kind != DM_LIE_PRODUCT)
+    describe1(G, g, &b);
+  for (i = 0; i < G->nfac; i++) {
+    if (i)
+      put(&b, " | ");
+    describe1(G->fac[i], g + G->qoff[i], &b);
+  }
+  return (int)b.len;
+}
+
 /* }====================================================================== */
 
 /* {==== dispatch ========================================================= */
@@ -321,8 +481,8 @@ void dm_lie_cay(const dm_lie_group *G, const double *xi, double *g)
 int dm_lie_icay(const dm_lie_group *G, const double *g, double *xi, dm_err *e)
 {
   if (G->type->icay(G, g, xi) != DM_OK)
-    return dm_err_set(e, DM_EDOM, "icay: the %s element is a rotation by pi, on the cut "
-                      "locus of the Cayley map (where its inverse is undefined)", G->name);
+    return dm_err_set(e, DM_EDOM, "the %s element is a rotation by pi: the inverse Cayley map "
+                      "is undefined there (its cut locus)", G->name);
   return DM_OK;
 }
 

@@ -174,6 +174,17 @@ dm_lie_group *dm_lie_group_copy(const dm_lie_group *G, dm_err *e);
 void dm_lie_group_free(dm_lie_group *G);
 /* 1 when G and H are the same group (same family, sizes and factors). */
 int dm_lie_group_equal(const dm_lie_group *G, const dm_lie_group *H);
+/* The group named by a name as in G->name ("SO3", "R2", "T3", "SE3xT3"):
+ * the inverse of the naming, for files that record a group by name.
+ * NULL and DM_EINVAL naming the part not understood. */
+dm_lie_group *dm_lie_group_parse(const char *name, dm_err *e);
+/* A one-line description of g into buf (truncated like snprintf; returns
+ * the full length): "rotation 1.5708 about (0, 0, 1) [0 -1 0; 1 0 0; 0 0 1]"
+ * (SO(3): angle, axis and matrix), "rotation ... , translation (1, 2, 3)"
+ * (SE(3)), "angle 0.5" (SO(2)), "angle 0.5, translation (1, 2)" (SE(2)),
+ * "(1, 2, 3)" (R^n), "angles (0.5, 1)" (T^n), factors joined by " | ".
+ * Numbers with 6 significant digits, C locale. */
+int dm_lie_describe(const dm_lie_group *G, const double *g, char *buf, size_t size);
 
 /* {==== elements (dispatch through G->type; see dm_lie_type) ============== */
 

@@ -204,12 +204,10 @@ static inline void dm_m3_tapply(const double *A, const double *x, double *y)
   y[2] = y2;
 }
 
-/* M = a I + b hat(w) + c hat(w)^2, written with leading dimension ld;
- * hat(w)^2 = w w^T - |w|^2 I. */
-static inline void dm_so3_poly(const double *w, double a, double b, double c, double *M,
-                               size_t ld)
+/* M = d I + b hat(w) + c w w^T, written with leading dimension ld. */
+static inline void dm_so3_poly_d(const double *w, double d, double b, double c, double *M,
+                                 size_t ld)
 {
-  double t = dm_v3_dot(w, w), d = a - c * t;
   M[0] = d + c * w[0] * w[0];
   M[1] = c * w[0] * w[1] - b * w[2];
   M[2] = c * w[0] * w[2] + b * w[1];
@@ -219,6 +217,13 @@ static inline void dm_so3_poly(const double *w, double a, double b, double c, do
   M[2 * ld] = c * w[0] * w[2] - b * w[1];
   M[2 * ld + 1] = c * w[1] * w[2] + b * w[0];
   M[2 * ld + 2] = d + c * w[2] * w[2];
+}
+
+/* M = a I + b hat(w) + c hat(w)^2 = (a - c|w|^2) I + b hat(w) + c w w^T */
+static inline void dm_so3_poly(const double *w, double a, double b, double c, double *M,
+                               size_t ld)
+{
+  dm_so3_poly_d(w, a - c * dm_v3_dot(w, w), b, c, M, ld);
 }
 
 /* y = (a I + b hat(w) + c hat(w)^2) x (y may alias x) */
@@ -233,11 +238,14 @@ static inline void dm_so3_poly_apply(const double *w, double a, double b, double
   y[2] = a * x[2] + b * wx[2] + c * wwx[2];
 }
 
-/* SO(3) exp (Rodrigues, series near 0) */
+/* SO(3) exp (Rodrigues, series near 0): cos(th) I + A hat(w) + B w w^T,
+ * the diagonal base cos(th) computed directly away from 0 (1 - B t would
+ * round cos(pi/2) to 1.1e-16) */
 static inline void dm_so3_exp(const double *w, double *R)
 {
-  double t = dm_v3_dot(w, w);
-  dm_so3_poly(w, 1.0, dm_lie_sinc(t), dm_lie_cosc(t), R, 3);
+  double t = dm_v3_dot(w, w), B = dm_lie_cosc(t);
+  double d = t < 1e-2 ? 1.0 - B * t : cos(sqrt(t));
+  dm_so3_poly_d(w, d, dm_lie_sinc(t), B, R, 3);
 }
 
 /* SO(3) Cayley map I + (4/(4 + |w|^2)) (hat(w) + hat(w)^2/2) */

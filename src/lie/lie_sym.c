@@ -133,7 +133,11 @@ void dm_lie_sym_m3_mul(dm_expr_ctx *c, const E *A, const E *B, E *C)
 
 void dm_lie_sym_so3_poly(dm_expr_ctx *c, const E *w, E a, E b, E cc, E *M, size_t ld)
 {
-  E d = s_sub(c, a, s_mul(c, cc, s_dot3(c, w, w)));
+  dm_lie_sym_so3_poly_d(c, w, s_sub(c, a, s_mul(c, cc, s_dot3(c, w, w))), b, cc, M, ld);
+}
+
+void dm_lie_sym_so3_poly_d(dm_expr_ctx *c, const E *w, E d, E b, E cc, E *M, size_t ld)
+{
   int i, j;
   for (i = 0; i < 3; i++)
     for (j = 0; j < 3; j++) {
@@ -173,10 +177,17 @@ void dm_lie_sym_m3_apply(dm_expr_ctx *c, const E *A, int trans, const E *x, E *y
   memcpy(y, r, sizeof r);
 }
 
+static E cos_closed(dm_expr_ctx *c, E t)
+{
+  return s_un(c, DM_EXPR_COS, s_un(c, DM_EXPR_SQRT, t));
+}
+
 void dm_lie_sym_so3_exp(dm_expr_ctx *c, const E *w, E *R)
 {
-  E t = s_dot3(c, w, w);
-  dm_lie_sym_so3_poly(c, w, s_k(c, 1.0), dm_lie_sym_sinc(c, t), dm_lie_sym_cosc(c, t), R, 3);
+  E t = s_dot3(c, w, w), B = dm_lie_sym_cosc(c, t), cond = s_bin(c, DM_EXPR_LT, t, s_k(c, 1e-2));
+  E d = s_sel(c, cond, s_sub(c, s_k(c, 1.0), s_mul(c, B, t)),
+              cos_closed(c, s_sel(c, cond, s_k(c, 1e-2), t)));
+  dm_lie_sym_so3_poly_d(c, w, d, dm_lie_sym_sinc(c, t), B, R, 3);
 }
 
 /* asin(sqrt u)/sqrt(u), series in u = sin^2 phi (exact rationals) */

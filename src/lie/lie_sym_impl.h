@@ -51,6 +51,8 @@ E dm_lie_sym_wrap(dm_expr_ctx *c, E a);
 void dm_lie_sym_m3_mul(dm_expr_ctx *c, const E *A, const E *B, E *C);
 /* M = a I + b hat(w) + cc hat(w)^2 with leading dimension ld */
 void dm_lie_sym_so3_poly(dm_expr_ctx *c, const E *w, E a, E b, E cc, E *M, size_t ld);
+/* M = d I + b hat(w) + cc w w^T */
+void dm_lie_sym_so3_poly_d(dm_expr_ctx *c, const E *w, E d, E b, E cc, E *M, size_t ld);
 /* y = (a I + b hat(w) + cc hat(w)^2) x (y may alias x) */
 void dm_lie_sym_so3_poly_apply(dm_expr_ctx *c, const E *w, E a, E b, E cc, const E *x, E *y);
 /* y = A x, y = A^T x for 3x3 A (y may alias x) */

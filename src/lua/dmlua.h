@@ -133,6 +133,7 @@ void dm_open_system(lua_State *L);      /* dm.system (l_system.c, l_system.h) */
 void dm_open_builtin(lua_State *L);     /* dm.builtin.*, dm.systems catalog (l_builtin.c) */
 void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.order_estimate, dm.methods */
 void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
+void dm_open_lie(lua_State *L);         /* dm.lie: Lie groups, systems on groups (l_lie*.c) */
 /* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
  * bindings whose objects make integrators (red:integrator). */
 int dm_lua_integrator(lua_State *L);

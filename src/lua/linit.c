@@ -17,6 +17,7 @@ static const dm_opener openers[] = {
   dm_open_integrator,
   dm_open_reduce,
   dm_open_dec,
+  dm_open_lie,
   NULL
 };
 
