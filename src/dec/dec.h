@@ -223,6 +223,44 @@ typedef int (*dm_dec_fn)(const double *x, double *vals, void *ud);
 int dm_dec_derham(const dm_dec_geom *G, int k, dm_dec_fn f, void *ud, double *out,
                   dm_err *e);
 
+/* {==== vector fields, wedge, contraction (doc/dec.md §7-§9) =============== */
+
+/* Flat of a dual vector field X (one R^N vector per top simplex, N_n x N)
+ * to a primal 1-cochain: <X^flat, e> = sum_s (|*e cap s|/|*e|) X(s).e_vec
+ * (edges with |*e| = 0: plain average over their top simplices). */
+int dm_dec_flat(const dm_dec_geom *G, const double *X, double *alpha, dm_err *e);
+/* Renormalised primal-primal sharp of a 1-cochain: a vector per vertex,
+ * V(v) = sum_s (|*v cap s|/|*v|) sum_{w in s} alpha([v,w]) grad lambda_w^s
+ * (N_0 x N).  Reproduces constant fields exactly. */
+int dm_dec_sharp(const dm_dec_geom *G, const double *alpha, double *V, dm_err *e);
+
+enum { DM_DEC_WEDGE_BARYCENTRIC = 0, DM_DEC_WEDGE_CIRCUMCENTRIC = 1 };
+/* Primal-primal wedge of a k-cochain a and an l-cochain b into a
+ * (k+l)-cochain out.  Barycentric weights 1/(p+1) (Leibniz rule exact,
+ * natural under maps) or circumcentric ones |s cap *v|/|s| (the thesis's
+ * Def 3.24; Leibniz only for closed factors). */
+int dm_dec_wedge(const dm_dec_geom *G, int k, const double *a, int l, const double *b,
+                 int weights, double *out, dm_err *e);
+
+/* Algebraic contraction of a dual k-cochain beta (N_{n-k} values, k >= 1)
+ * with a dual vector field X: (-1)^(k(n-k)) *((*beta) ^ X^flat), a dual
+ * (k-1)-cochain (N_{n-k+1} values); Lie derivative by Cartan's formula
+ * L_X = i_X D + D i_X (dual k-cochain to dual k-cochain). */
+int dm_dec_contract(const dm_dec_geom *G, int k, const double *beta, const double *X,
+                    int weights, double *out, dm_err *e);
+int dm_dec_lie(const dm_dec_geom *G, int k, const double *beta, const double *X, int weights,
+               double *out, dm_err *e);
+
+/* The cone operators of a collapsible complex: p[k] (N_k x N_{k+1}, k =
+ * 0..n-1, integer entries), row tau holding the chain p(tau), with
+ * p d + d p = I on k-chains (k >= 1) and d p(v) = v - apex.  Read as a
+ * matrix on cochains, p[k] is the homotopy H: C^{k+1} -> C^k, and
+ * p[k] d[k] + d[k-1] p[k-1] = I (k >= 1), p[0] d[0] f = f - f(apex),
+ * d[n-1] p[n-1] = I.  DM_EFAILED
+ * naming what is left when greedy collapses do not reach a point (not
+ * contractible, or a non-collapsible order such as the dunce hat). */
+int dm_dec_homotopy(const dm_dec_complex *K, dm_sparse **p, int *apex, dm_err *e);
+
 /* }==== */
 
 /* {==== solving operators of the form diag(w)^-1 S ============================ */
