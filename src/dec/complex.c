@@ -402,6 +402,27 @@ static void face_name(const dm_dec_complex *K, int k, int s, char *buf, size_t s
     snprintf(buf + len, size - (size_t)len, ")");
 }
 
+int dm_dec_complex_defect(const dm_dec_complex *K, int *a, int *b, int *f)
+{
+  dm_sparse *Dt;
+  int i, kind = 0;
+  if (K->manifold && K->oriented)
+    return 0;
+  if ((Dt = dm_sparse_transpose(K->d[K->n - 1], NULL)) == NULL)
+    return -1;
+  for (i = 0; i < Dt->nrows && kind == 0; i++) {
+    int c = Dt->rowptr[i + 1] - Dt->rowptr[i], p = Dt->rowptr[i];
+    if (c > 2 || (c == 2 && Dt->val[p] == Dt->val[p + 1])) {
+      kind = c > 2 ? 1 : 2;
+      *a = Dt->col[p];
+      *b = Dt->col[p + 1];
+      *f = i;
+    }
+  }
+  dm_sparse_free(Dt);
+  return kind;
+}
+
 int dm_dec_complex_check(const dm_dec_complex *K, dm_err *e)
 {
   int n = K->n, i, p;

@@ -96,6 +96,7 @@ int dm_dec_delaunay_flips(dm_dec_meshdata *m, dm_err *e);
  * (old vertices: both entries equal the vertex itself), 2 ints per vertex. */
 dm_dec_meshdata *dm_dec_refine(const dm_dec_meshdata *m, int **parent, dm_err *e);
 
+
 /* }==== */
 
 /* {==== the complex ========================================================== */
@@ -142,6 +143,9 @@ int dm_dec_find(const dm_dec_complex *K, int k, const int *v);
  * ("non-manifold"), two cofaces inducing the same orientation on a shared
  * face ("inconsistent orientation").  DM_OK when neither. */
 int dm_dec_complex_check(const dm_dec_complex *K, dm_err *e);
+/* The same as data: 0 (none), 1 (non-manifold: face f of the top simplices
+ * a, b, ...), 2 (orientation: top simplices a and b share face f). */
+int dm_dec_complex_defect(const dm_dec_complex *K, int *a, int *b, int *f);
 
 /* Betti numbers b_0..b_n, exactly: ranks of the boundary matrices by
  * elimination modulo the prime 2^31 - 1 (equal to the rational ranks unless
@@ -223,6 +227,8 @@ typedef int (*dm_dec_fn)(const double *x, double *vals, void *ud);
 int dm_dec_derham(const dm_dec_geom *G, int k, dm_dec_fn f, void *ud, double *out,
                   dm_err *e);
 
+/* }==== */
+
 /* {==== vector fields, wedge, contraction (doc/dec.md §7-§9) =============== */
 
 /* Flat of a dual vector field X (one R^N vector per top simplex, N_n x N)
@@ -263,6 +269,40 @@ int dm_dec_homotopy(const dm_dec_complex *K, dm_sparse **p, int *apex, dm_err *e
 
 /* }==== */
 
+/* {==== maps and nested meshes (doc/dec.md §11, §12) ========================== */
+
+/* Push-forward of a dual vector field X (N_n x N1) from geometry G1 to G2
+ * of the same complex: J_s X(s), J_s = E2 (E1^T E1)^-1 E1^T the Jacobian of
+ * the affine map of top simplex s.  Pull-back: swap G1 and G2.  Cochains
+ * need no transfer (same simplices: f^* d = d f^*). */
+int dm_dec_pushforward(const dm_dec_geom *G1, const dm_dec_geom *G2, const double *X, double *out,
+                       dm_err *e);
+
+/* For Kf from dm_dec_refine of Kc's mesh (parent as returned there):
+ * restriction of fine k-cochains to coarse ones (k = 0, 1 or n), sums over
+ * pieces, commuting with d; linear prolongation of 0-cochains (nf x nc). */
+dm_sparse *dm_dec_restriction(const dm_dec_complex *Kc, const dm_dec_complex *Kf, const int *parent,
+                              int k, dm_err *e);
+dm_sparse *dm_dec_prolongation(int nc, int nf, const int *parent, dm_err *e);
+
+/* Geometric multigrid for S u = b, S symmetric positive definite on the
+ * finest level, levels linked by prolongations P[l] (level l+1 from level
+ * l, l = 0..nlev-2), coarse operators P^T S P, fixed (Dirichlet) unknowns
+ * of the finest level held at zero (the rows of b there are ignored).
+ * V(nu, nu) cycles with symmetric Gauss-Seidel, CHOLMOD on level 0. */
+typedef struct dm_dec_mg dm_dec_mg;
+dm_dec_mg *dm_dec_mg_alloc(int nlev, dm_sparse *const *P, const dm_sparse *S,
+                           const unsigned char *fixed, int nu, dm_err *e);
+/* One V-cycle: u <- u + V(b - S u) on the free unknowns. */
+int dm_dec_mg_vcycle(dm_dec_mg *M, const double *b, double *u, dm_err *e);
+/* Cycles until the residual's 2-norm is below tol times that of b (at
+ * most maxit); *iters receives the count.  DM_ENOCONV otherwise. */
+int dm_dec_mg_solve(dm_dec_mg *M, const double *b, double *u, double tol, int maxit, int *iters,
+                    dm_err *e);
+void dm_dec_mg_free(dm_dec_mg *M);
+
+/* }==== */
+
 /* {==== solving operators of the form diag(w)^-1 S ============================ */
 
 /* A factored Dirichlet problem: S symmetric (n x n), `fixed` flags (may be
@@ -277,6 +317,26 @@ dm_dec_solver *dm_dec_solver_alloc(const dm_sparse *S, const unsigned char *fixe
 int dm_dec_solver_solve(dm_dec_solver *F, const double *w, const double *f,
                         const double *g, double *u, dm_err *e);
 void dm_dec_solver_free(dm_dec_solver *F);
+
+/* }==== */
+
+/* {==== mesh files (doc/dec.md §13) ======================================= */
+
+/* Read a mesh file: OFF (triangles), Wavefront OBJ (v and triangular f
+ * lines), Gmsh .msh ASCII 2.2 or 4.1 (points, lines, triangles, tetrahedra;
+ * the highest dimension present gives the top simplices).  Coordinates
+ * with every z = 0 make a planar mesh (N = 2).  lines (may be NULL)
+ * receives the line number of every top simplex (free()).  Errors name
+ * the file, the line and the defect ("mesh.off:12: vertex 57 does not
+ * exist (vertices are numbered from 0)"). */
+int dm_dec_read(const char *path, dm_dec_meshdata **out, int **lines, dm_err *e);
+/* Write OFF, OBJ (triangle meshes) or .msh 2.2 by the extension of path,
+ * through a temporary file renamed over path. */
+int dm_dec_write(const char *path, const dm_dec_complex *K, const dm_dec_geom *G, dm_err *e);
+/* Read, build the complex and its geometry; a non-manifold face or an
+ * inconsistently oriented pair is an error naming the lines of the
+ * simplices. */
+int dm_dec_load(const char *path, dm_dec_complex **K, dm_dec_geom **G, dm_err *e);
 
 /* }==== */
 

@@ -38,8 +38,26 @@ static void mesh_clear(dm_lmesh *M)
 {
   dm_dec_geom_free(M->G);
   dm_dec_complex_free(M->K);
+  free(M->parent);
   M->G = NULL;
   M->K = NULL;
+  M->parent = NULL;
+}
+
+dm_lmesh *dm_pushmesh(lua_State *L, dm_dec_complex *K, dm_dec_geom *G, const char *what, dm_err *e)
+{
+  dm_lmesh *M;
+  if (K == NULL || G == NULL) {
+    dm_dec_geom_free(G);
+    dm_dec_complex_free(K);
+    dm_lua_fail(L, what, e->status, e);
+  }
+  M = lua_newuserdatauv(L, sizeof *M, 1);
+  memset(M, 0, sizeof *M);
+  M->K = K;
+  M->G = G;
+  luaL_setmetatable(L, DM_MESH_MT);
+  return M;
 }
 
 static int m_gc(lua_State *L)
@@ -119,7 +137,7 @@ static dm_lmesh *push_mesh(lua_State *L, dm_dec_meshdata *m, const char *what, d
   dm_lmesh *M;
   if (m == NULL)
     dm_lua_fail(L, what, e->status, e);
-  M = lua_newuserdatauv(L, sizeof *M, 0);
+  M = lua_newuserdatauv(L, sizeof *M, 1);
   memset(M, 0, sizeof *M);
   luaL_setmetatable(L, DM_MESH_MT);
   M->K = dm_dec_complex_alloc(m->n, m->nv, m->ntop, m->T, e);
@@ -333,7 +351,7 @@ static int l_new(lua_State *L)
     T[i] = (int)S[i] - 1;
   if (w < 2 || w > DM_DEC_MAXDIM + 1)
     return luaL_error(L, "dm.mesh.new: simplices of %d vertices (2..%d expected)", w, DM_DEC_MAXDIM + 1);
-  M = lua_newuserdatauv(L, sizeof *M, 0);
+  M = lua_newuserdatauv(L, sizeof *M, 1);
   memset(M, 0, sizeof *M);
   luaL_setmetatable(L, DM_MESH_MT);
   if ((M->K = dm_dec_complex_alloc(w - 1, nv, nt, T, &e)) == NULL)
@@ -838,4 +856,5 @@ void dm_open_dec(lua_State *L)
   lua_newtable(L);
   dm_register(L, "dm.mesh.", mesh_funcs);
   lua_setfield(L, -2, "mesh");
+  dm_open_dec_ops(L);
 }

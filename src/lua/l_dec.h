@@ -21,6 +21,8 @@ typedef struct dm_lmesh {
   dm_dec_complex *K;
   dm_dec_geom *G;
   unsigned warned;             /* bit k: nonpositive *_k reported */
+  int *parent;                 /* made by M:refine(): 2 coarse vertices per
+                                  vertex; the coarse mesh is user value 1 */
 } dm_lmesh;
 
 typedef struct dm_ltype {
@@ -55,6 +57,11 @@ dm_lmesh *dm_checkmesh(lua_State *L, int arg);
 const char *dm_dec_typename(lua_State *L, dm_ltype t);
 /* Number of values of a cochain of type t. */
 int dm_dec_typesize(const dm_dec_complex *K, dm_ltype t);
+
+/* Push a new Mesh owning K and G (NULL: raise e's message). */
+dm_lmesh *dm_pushmesh(lua_State *L, dm_dec_complex *K, dm_dec_geom *G, const char *what, dm_err *e);
+/* The methods of l_dec_ops.c into the Mesh class, dm.mesh.load. */
+void dm_open_dec_ops(lua_State *L);
 
 /* sparse matrices (l_dec_sparse.c): an empty Sparse pushed, user value =
  * the value at mesh_idx (0: none). */
