@@ -32,7 +32,9 @@ local function new_state(write, exit)
           write = write, exit = exit}
 end
 
-local state = new_state(function(s) io.stdout:write(s); io.stdout:flush() end, os.exit)
+-- exit closes the Lua state, so leak checkers see a failing __gc
+local state = new_state(function(s) io.stdout:write(s); io.stdout:flush() end,
+                        function(code) os.exit(code, true) end)
 
 local function emit(s) state.write(s) end
 

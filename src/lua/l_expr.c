@@ -10,7 +10,12 @@
 #include "lua/l_expr.h"
 #include "expr/native.h"
 
+/* The registry slot holding the context box and the box's metatable must
+ * have different names: luaL_newmetatable stores the metatable in the
+ * registry under its name, so one name for both made __gc's type check
+ * fail at lua_close and leaked the whole context. */
 #define CTX_KEY "dmech.exprctx"
+#define CTX_MT "dmech.exprctx.mt"
 #define SYMVEC_MT "dmech.symvec"
 #define LABELS_KEY "dmech.symvec.labels"
 #define SYMVEC_DATA_KEY "dmech.symvec.data"
@@ -28,7 +33,7 @@ typedef struct ctxbox {
 
 static int ctx_gc(lua_State *L)
 {
-  ctxbox *b = luaL_checkudata(L, 1, CTX_KEY);
+  ctxbox *b = luaL_checkudata(L, 1, CTX_MT);
   dm_expr_ctx_free(b->ctx);
   b->ctx = NULL;
   return 0;
@@ -47,7 +52,7 @@ dm_expr_ctx *dm_lua_exprctx(lua_State *L)
   lua_pop(L, 1);
   b = lua_newuserdatauv(L, sizeof *b, 0);
   b->ctx = NULL;
-  if (luaL_newmetatable(L, CTX_KEY)) {
+  if (luaL_newmetatable(L, CTX_MT)) {
     lua_pushcfunction(L, ctx_gc);
     lua_setfield(L, -2, "__gc");
   }
