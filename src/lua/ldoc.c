@@ -92,6 +92,15 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
     } else {
       lua_pop(L, 1);
     }
+    /* Lua names a C function that was called without a name (through
+     * pcall, a tail call, a local) by searching package.loaded, as it does
+     * for string.rep: put the methods there so that errors say
+     * "bad argument #2 to 'dmech.trajectory.meta'", not "to '?'". */
+    luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    lua_pushfstring(L, "dmech.%s", kind);
+    lua_pushvalue(L, -3);
+    lua_settable(L, -3);
+    lua_pop(L, 1);
     lua_setfield(L, -2, "__methods");   /* for completion and the doc test */
   }
 }
