@@ -482,6 +482,10 @@ local function check_output_opts(what, o)
   if o.output ~= nil and type(o.output) ~= "string" then
     fail(what, "output: file name expected, got %s", type(o.output))
   end
+  if o.output ~= nil and o.output:find("\0", 1, true) then
+    fail(what, "output: file name without NUL bytes expected, got a NUL byte at position %d",
+         o.output:find("\0", 1, true))
+  end
   if o.terminal ~= nil and type(o.terminal) ~= "string" then
     fail(what, "terminal: string expected, got %s", type(o.terminal))
   end

@@ -240,9 +240,12 @@ int dm_traj_meta_number_at(const dm_traj *tr, size_t i, double *x);
  * DM_TRAJ_DATA column.  Errors name the file, the line and what was expected.
  */
 
-/* Save to path atomically (temp file in the same directory, fsync, rename).
- * DM_EIO (message with path and strerror), DM_EINTR; on failure no file is
- * left at path's temporary name and an existing file at path is untouched. */
+/* Save to path as core/outfile.h writes: a regular file (or nothing) is
+ * replaced atomically (temp file in the same directory, fsync, rename), a
+ * symbolic link is followed, a FIFO or character device is written
+ * through, anything else refused.  DM_EIO (message with path and
+ * strerror), DM_EINVAL (refused), DM_EINTR; on failure no temporary file
+ * is left and an existing file at path is untouched. */
 int dm_traj_save(const dm_traj *tr, const char *path, dm_err *e);
 
 /* Write the CSV text to a stream (no atomicity; `name` is used in messages). */

@@ -17,6 +17,7 @@
 
 #include "core/interrupt.h"
 #include "core/numfmt.h"
+#include "core/outfile.h"
 
 #define MAGIC "# dmech trajectory "
 #define FORMAT_VERSION 2     /* 2: numeric metadata ("# number"); 1 without */
@@ -100,103 +101,20 @@ int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
   return st;
 }
 
-/* Create "<path>.tmp-<random>" exclusively (mode 0666 minus the umask, like
- * the final file would get).  O_EXCL makes a guessed name harmless. */
-static int open_temp(const char *path, char **tmp, dm_err *e)
-{
-  static unsigned counter;
-  size_t lp = strlen(path);
-  int attempt;
-  *tmp = malloc(lp + 32);
-  if (*tmp == NULL)
-    return dm_err_set(e, DM_ENOMEM, "saving '%.200s': out of memory", path);
-  for (attempt = 0; attempt < 100; attempt++) {
-    struct timespec ts;
-    uint64_t r;
-    int fd;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    r = ((uint64_t)ts.tv_nsec << 20) ^ (uint64_t)ts.tv_sec
-        ^ ((uint64_t)getpid() << 40) ^ ((uint64_t)(uintptr_t)tmp << 7)
-        ^ (uint64_t)(++counter) * 0x9e3779b97f4a7c15ULL;
-    snprintf(*tmp, lp + 32, "%s.tmp-%016llx", path, (unsigned long long)r);
-    fd = open(*tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0)
-      return fd;
-    if (errno != EEXIST)
-      break;
-  }
-  dm_err_set(e, DM_EIO, "saving '%.200s': cannot create a temporary file "
-             "next to it: %s", path, strerror(errno));
-  free(*tmp);
-  *tmp = NULL;
-  return -1;
-}
-
-/* fsync the directory holding path so the rename itself is durable; a
- * failure here is not reported (the data are safe, only the name may lag). */
-static void sync_dir(const char *path)
-{
-  const char *slash = strrchr(path, '/');
-  char *dir;
-  int fd;
-  if (slash == NULL) {
-    dir = malloc(2);
-    if (dir != NULL)
-      strcpy(dir, ".");
-  } else {
-    size_t k = slash == path ? 1 : (size_t)(slash - path);
-    dir = malloc(k + 1);
-    if (dir != NULL) {
-      memcpy(dir, path, k);
-      dir[k] = '\0';
-    }
-  }
-  if (dir == NULL)
-    return;
-  fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd >= 0) {
-    fsync(fd);
-    close(fd);
-  }
-  free(dir);
-}
-
 int dm_traj_save(const dm_traj *tr, const char *path, dm_err *e)
 {
-  char *tmp = NULL;
-  FILE *f;
-  int fd, st;
+  dm_outfile o;
+  int st;
   if (path == NULL || path[0] == '\0')
     return dm_err_set(e, DM_EINVAL, "save: empty file name");
-  fd = open_temp(path, &tmp, e);
-  if (fd < 0)
-    return e != NULL ? e->status : DM_EIO;
-  f = fdopen(fd, "w");
-  if (f == NULL) {
-    st = dm_err_set(e, DM_EIO, "saving '%.200s': %s", path, strerror(errno));
-    close(fd);
-    goto fail;
+  if ((st = dm_outfile_open(&o, path, "saving", 0, NULL, e)) != DM_OK)
+    return st;
+  st = dm_traj_write(tr, o.f, path, e);
+  if (st != DM_OK) {
+    dm_outfile_abandon(&o);
+    return st;
   }
-  st = dm_traj_write(tr, f, path, e);
-  if (st == DM_OK && fsync(fileno(f)) != 0)
-    st = dm_err_set(e, DM_EIO, "saving '%.200s': fsync: %s", path,
-                    strerror(errno));
-  if (fclose(f) != 0 && st == DM_OK)
-    st = dm_err_set(e, DM_EIO, "saving '%.200s': %s", path, strerror(errno));
-  if (st != DM_OK)
-    goto fail;
-  if (rename(tmp, path) != 0) {
-    st = dm_err_set(e, DM_EIO, "saving '%.200s': cannot rename the temporary "
-                    "file: %s", path, strerror(errno));
-    goto fail;
-  }
-  free(tmp);
-  sync_dir(path);
-  return DM_OK;
-fail:
-  unlink(tmp);
-  free(tmp);
-  return st;
+  return dm_outfile_commit(&o, e);
 }
 
 /* }==== */

@@ -68,6 +68,13 @@ int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e);
 int dm_argexpected(lua_State *L, int arg, const char *expected,
                    const char *actual);
 
+/* luaL_checkstring for strings that go to C as C strings (file names,
+ * names, metadata): one holding a NUL byte is refused, never truncated. */
+const char *dm_checkcstring(lua_State *L, int arg);
+/* lua_tostring with the same check on a value that is not an argument;
+ * `what` starts the message "<what>: NUL byte at position k of "...""). */
+const char *dm_tocstring(lua_State *L, int idx, const char *what);
+
 /* Option value from the table at index t: number field `key` or default;
  * raises "bad argument #t to 'f' (field 'key': number expected, got X)". */
 double dm_optnumberfield(lua_State *L, int t, const char *key, double def);

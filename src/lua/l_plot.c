@@ -392,7 +392,7 @@ static int gp_timeout(lua_State *L)
 
 static int gp_program(lua_State *L)
 {
-  const char *p = lua_toboolean(L, 1) ? luaL_checkstring(L, 1) : NULL;
+  const char *p = lua_toboolean(L, 1) ? dm_checkcstring(L, 1) : NULL;
   dm_err e;
   if (dm_gp_set_program(session(L), p, &e) != DM_OK)
     return raise(L, current_what(L), e.status, &e);

@@ -161,7 +161,7 @@ static int cols_index(lua_State *L)
     lua_Integer k = luaL_checkinteger(L, 2);
     i = k >= 1 && (lua_Unsigned)k <= n ? (size_t)k - 1 : n;
   } else {
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = dm_checkcstring(L, 2);
     for (i = 0; i < n && strcmp(dm_traj_coord(tr, i), name) != 0; i++)
       ;
   }
@@ -315,7 +315,7 @@ static int t_tostring(lua_State *L)
 static int t_column(lua_State *L)
 {
   dm_traj *tr = dm_checktraj(L, 1);
-  const char *name = luaL_checkstring(L, 2);
+  const char *name = dm_checkcstring(L, 2);
   size_t j = dm_traj_find(tr, name);
   if (j == DM_TRAJ_NONE)
     return no_column(L, 2, tr, name);
@@ -367,7 +367,7 @@ static int t_meta(lua_State *L)
     return 1;
   }
   if (lua_gettop(L) >= 3) {
-    const char *key = luaL_checkstring(L, 2);
+    const char *key = dm_checkcstring(L, 2);
     dm_err e;
     if (dm_ltraj_setmeta(L, tr, key, 3, &e) != DM_OK)
       return luaL_argerror(L, 2, e.msg);
@@ -375,7 +375,7 @@ static int t_meta(lua_State *L)
     return 1;
   }
   {
-    const char *key = luaL_checkstring(L, 2);
+    const char *key = dm_checkcstring(L, 2);
     for (i = 0; i < dm_traj_meta_count(tr); i++) {
       const char *k;
       dm_traj_meta_at(tr, i, &k, NULL);
@@ -567,7 +567,7 @@ static int t_derive(lua_State *L)
 static int t_save(lua_State *L)
 {
   dm_traj *tr = dm_checktraj(L, 1);
-  const char *path = luaL_checkstring(L, 2);
+  const char *path = dm_checkcstring(L, 2);
   dm_err e;
   if (dm_traj_save(tr, path, &e) != DM_OK) {
     luaL_pushfail(L);
@@ -580,7 +580,7 @@ static int t_save(lua_State *L)
 
 static int l_load(lua_State *L)
 {
-  const char *path = luaL_checkstring(L, 1);
+  const char *path = dm_checkcstring(L, 1);
   dm_traj **slot = dm_newtraj(L);
   dm_err e;
   *slot = dm_traj_load(path, &e);
@@ -616,7 +616,7 @@ static int t_momentum(lua_State *L)
   dm_traj *tr = dm_checktraj(L, 1);
   size_t lp = strlen(DM_TRAJ_MOMENTUM), j, found = DM_TRAJ_NONE, count = 0;
   if (!lua_isnoneornil(L, 2)) {
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = dm_checkcstring(L, 2);
     lua_pushfstring(L, "%s%s", DM_TRAJ_MOMENTUM, name);
     return push_diag(L, tr, lua_tostring(L, -1), "momentum");
   }

@@ -18,7 +18,9 @@ int dm_ltraj_setmeta(lua_State *L, dm_traj *tr, const char *key, int arg, dm_err
     return dm_traj_meta_set(tr, key, NULL, e);
   if (t == LUA_TNUMBER)
     return dm_traj_meta_set_number(tr, key, lua_tonumber(L, arg), e);
-  if (t == LUA_TSTRING || t == LUA_TBOOLEAN) {
+  if (t == LUA_TSTRING)
+    return dm_traj_meta_set(tr, key, dm_tocstring(L, arg, "metadata value"), e);
+  if (t == LUA_TBOOLEAN) {
     int st = dm_traj_meta_set(tr, key, luaL_tolstring(L, arg, NULL), e);
     lua_pop(L, 1);
     return st;
@@ -103,7 +105,7 @@ static const char **sorted_keys(lua_State *L, int idx, size_t *count, const char
     if (lua_type(L, -2) != LUA_TSTRING)
       luaL_error(L, "bad argument #1 to 'trajectory' (field '%s': keys must be "
                  "column names, got a %s key)", what, luaL_typename(L, -2));
-    keys[k++] = lua_tostring(L, -2);      /* anchored in the table */
+    keys[k++] = dm_tocstring(L, -2, "dm.trajectory");   /* anchored in the table */
     lua_pop(L, 1);
   }
   qsort(keys, n, sizeof *keys, cmp_str);
@@ -135,7 +137,7 @@ static const char **coord_names(lua_State *L, size_t *n)
     if (lua_rawgeti(L, -2, (lua_Integer)i + 1) != LUA_TSTRING)
       luaL_error(L, "bad argument #1 to 'trajectory' (field 'coords': name %I is %s, "
                  "string expected)", (lua_Integer)i + 1, luaL_typename(L, -1));
-    names[i] = lua_tostring(L, -1);
+    names[i] = dm_tocstring(L, -1, "dm.trajectory");
     lua_pop(L, 1);
   }
   return names;

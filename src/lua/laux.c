@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/numfmt.h"
 #include "lua/dmlua.h"
 
 int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e)
@@ -20,11 +21,40 @@ int dm_argexpected(lua_State *L, int arg, const char *expected,
   return luaL_argerror(L, arg, msg);
 }
 
+const char *dm_checkcstring(lua_State *L, int arg)
+{
+  size_t len;
+  const char *s = luaL_checklstring(L, arg, &len);
+  if (strlen(s) != len)
+    dm_argexpected(L, arg, "string without NUL bytes",
+                   lua_pushfstring(L, "a string with a NUL byte at position %d",
+                                   (int)strlen(s) + 1));
+  return s;
+}
+
+const char *dm_tocstring(lua_State *L, int idx, const char *what)
+{
+  size_t len;
+  const char *s = lua_tolstring(L, idx, &len);
+  if (s != NULL && strlen(s) != len)
+    luaL_error(L, "%s: NUL byte at position %d of \"%s\" (C strings end "
+               "there)", what, (int)strlen(s) + 1, s);
+  return s;
+}
+
+/* The field's value is on top of the stack. */
 static int fielderror(lua_State *L, int t, const char *key, const char *want)
 {
-  const char *msg = lua_pushfstring(L, "field '%s': %s expected, got %s", key,
-                                    want, luaL_typename(L, -2));
-  return luaL_argerror(L, t, msg);
+  const char *got;
+  if (lua_type(L, -1) == LUA_TNUMBER) {
+    char buf[32];
+    dm_num_format(buf, sizeof buf, lua_tonumber(L, -1));
+    got = lua_pushfstring(L, "%s", buf);
+  } else {
+    got = luaL_typename(L, -1);
+  }
+  return luaL_argerror(L, t, lua_pushfstring(L, "field '%s': %s expected, got %s",
+                                             key, want, got));
 }
 
 double dm_optnumberfield(lua_State *L, int t, const char *key, double def)
@@ -72,6 +102,12 @@ const char *dm_optstringfield(lua_State *L, int t, const char *key,
     return NULL;
   }
   s = lua_tostring(L, -1);
+  if (strlen(s) != lua_rawlen(L, -1)) {
+    luaL_argerror(L, t, lua_pushfstring(L, "field '%s': string without NUL "
+                                        "bytes expected, got a NUL byte at "
+                                        "position %d", key, (int)strlen(s) + 1));
+    return NULL;
+  }
   lua_pop(L, 1);
   return s;
 }

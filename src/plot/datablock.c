@@ -20,6 +20,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "core/cleanup.h"
 #include "core/interrupt.h"
 #include "core/numfmt.h"
 #include "plot/gp_private.h"
@@ -48,7 +49,9 @@ static size_t fmt_row(char *line, size_t i, size_t ncols,
   return k;
 }
 
-static int ensure_datadir(dm_gp_session *s, dm_err *e)
+/* The session's private directory (mkdtemp, 0700), created on first use
+ * and registered for removal at exit or on a fatal signal. */
+int gp_ensure_datadir(dm_gp_session *s, dm_err *e)
 {
   const char *base = getenv("TMPDIR");
   char *dir;
@@ -68,6 +71,7 @@ static int ensure_datadir(dm_gp_session *s, dm_err *e)
                       "data in %s: %s", base, strerror(err));
   }
   s->datadir = dir;
+  s->datadir_slot = dm_cleanup_add_dir(dir);
   return DM_OK;
 }
 
@@ -89,6 +93,8 @@ void gp_data_cleanup(dm_gp_session *s, int remove_dir)
   }
   if (remove_dir) {
     rmdir(s->datadir);
+    dm_cleanup_drop(s->datadir_slot);
+    s->datadir_slot = -1;
     free(s->datadir);
     s->datadir = NULL;
   }
@@ -119,7 +125,7 @@ static int block_file(dm_gp_session *s, const char *name, size_t nrows,
   char line[8 * 26 + 2], path[4096];
   FILE *f;
   size_t i, k;
-  int rc = ensure_datadir(s, e), bad;
+  int rc = gp_ensure_datadir(s, e), bad;
   if (rc != DM_OK)
     return rc;
   snprintf(path, sizeof path, "%s/%s.dat", s->datadir, name);

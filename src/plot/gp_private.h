@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <sys/types.h>
 
+#include "core/outfile.h"
 #include "plot/gnuplot.h"
 
 /* A growable byte buffer, always NUL terminated when p != NULL. */
@@ -42,11 +43,12 @@ struct dm_gp_session {
   gp_buf last_err;        /* stderr tail kept for "gnuplot exited" */
 
   char *datadir;          /* private directory for large datablocks */
+  int datadir_slot;       /* its core/cleanup.h registration */
   char terminals[2048];   /* GPVAL_TERMINALS */
   double version;
 
   /* pending file output (set_terminal with a file) */
-  char *out_final, *out_tmp;
+  dm_outfile out;         /* gnuplot writes out.tmp (out.path: none) */
   int out_open;           /* `unset output` not yet sent */
   int to_stdout;          /* current terminal writes to gnuplot's stdout */
 };
@@ -74,6 +76,7 @@ int gp_roundtrip(dm_gp_session *s, const char *what, int *gp_errno,
                  dm_err *e);
 
 /* datablock.c */
+int gp_ensure_datadir(dm_gp_session *s, dm_err *e);
 void gp_data_cleanup(dm_gp_session *s, int remove_dir);
 
 /* terminal.c */

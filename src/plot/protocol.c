@@ -91,6 +91,7 @@ dm_gp_session *dm_gp_session_alloc(void)
     return NULL;
   s->pid = -1;
   s->fd_in = s->fd_out = s->fd_err = -1;
+  s->datadir_slot = s->out.slot = -1;
   s->timeout = GP_DEFAULT_TIMEOUT;
   env = getenv("DMECH_GNUPLOT_TIMEOUT");
   if (env != NULL && *env != '\0') {

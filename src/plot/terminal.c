@@ -1,10 +1,12 @@
 /* terminal.c -- which gnuplot terminal, in what size, and file outputs.
  *
- * A file output goes to a temporary file created (O_EXCL, unpredictable
- * name) beside the target; the checkpoint that ends the transaction sends
- * `unset output` and renames it onto the target only when gnuplot reported
- * no error, so a failed plot never clobbers an older good file and a
- * successful one is complete when the call returns.
+ * A file output goes to a temporary file (core/outfile.h in named mode:
+ * O_EXCL, unpredictable name, beside the target); the checkpoint that ends
+ * the transaction sends `unset output` and renames it onto the target only
+ * when gnuplot reported no error, so a failed plot never clobbers an older
+ * good file and a successful one is complete when the call returns.  A
+ * symbolic link is followed; a FIFO or character device gets the finished
+ * plot copied into it; a directory or block device is refused.
  */
 #include <config.h>
 
@@ -15,6 +17,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -255,39 +258,6 @@ int dm_gp_terminal_command(const dm_gp_session *s, const dm_gp_termreq *req,
 
 /* {==== file outputs ======================================================== */
 
-/* Create an empty file with an unpredictable name beside `file`; returns a
- * malloc'ed name or NULL (errno set). */
-static char *make_temp(const char *file)
-{
-  static unsigned long counter;
-  const char *slash = strrchr(file, '/');
-  size_t dirlen = slash != NULL ? (size_t)(slash - file + 1) : 0;
-  size_t n = strlen(file) + 48;
-  char *name = malloc(n);
-  int i;
-  if (name == NULL)
-    return NULL;
-  for (i = 0; i < 100; i++) {
-    struct timespec ts;
-    unsigned long r;
-    int fd;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    r = (unsigned long)ts.tv_nsec ^ ((unsigned long)getpid() << 16)
-        ^ (++counter * 2654435761UL);
-    snprintf(name, n, "%.*s.%s.%08lx.tmp", (int)dirlen, file, file + dirlen,
-             r & 0xffffffffUL);
-    fd = open(name, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      close(fd);
-      return name;
-    }
-    if (errno != EEXIST)
-      break;
-  }
-  free(name);
-  return NULL;
-}
-
 static int check_filename(const char *file, dm_err *e)
 {
   const unsigned char *p;
@@ -305,6 +275,7 @@ static int check_filename(const char *file, dm_err *e)
 
 int dm_gp_set_terminal(dm_gp_session *s, const dm_gp_termreq *req, dm_err *e)
 {
+  struct stat st;
   dm_gp_termenv env;
   char cmd[512];
   int rc;
@@ -320,18 +291,18 @@ int dm_gp_set_terminal(dm_gp_session *s, const dm_gp_termreq *req, dm_err *e)
     return dm_gp_send(s, e, "%s\nset output\n", cmd);
   }
   gp_output_discard(s);
-  s->out_final = strdup(req->file);
-  s->out_tmp = s->out_final != NULL ? make_temp(req->file) : NULL;
-  if (s->out_tmp == NULL) {
-    int err = errno;
-    gp_output_discard(s);
-    return dm_err_set(e, DM_EIO, "cannot create '%.200s': %s", req->file,
-                      strerror(err));
-  }
+  /* a device or FIFO gets the finished plot copied from a private file */
+  if (stat(req->file, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))
+      && (rc = gp_ensure_datadir(s, e)) != DM_OK)
+    return rc;
+  rc = dm_outfile_open(&s->out, req->file, "plot output", DM_OUTFILE_NAMED,
+                       s->datadir, e);
+  if (rc != DM_OK)
+    return rc;
   s->to_stdout = 0;
   rc = dm_gp_send(s, e, "set terminal push\n%s\nset output ", cmd);
   if (rc == DM_OK)
-    rc = dm_gp_sendq(s, s->out_tmp, strlen(s->out_tmp), DM_GP_QUOTE_ONELINE, e);
+    rc = dm_gp_sendq(s, s->out.tmp, strlen(s->out.tmp), DM_GP_QUOTE_ONELINE, e);
   if (rc == DM_OK)
     rc = dm_gp_send(s, e, "\n");
   s->out_open = 1;
@@ -341,7 +312,7 @@ int dm_gp_set_terminal(dm_gp_session *s, const dm_gp_termreq *req, dm_err *e)
 int gp_output_close(dm_gp_session *s, dm_err *e)
 {
   static const char cmd[] = "\nunset output\nset terminal pop\n";
-  if (s->out_tmp == NULL || !s->out_open)
+  if (s->out.tmp == NULL || !s->out_open)
     return DM_OK;
   s->out_open = 0;
   return gp_append(s, cmd, sizeof cmd - 1, e);
@@ -349,27 +320,13 @@ int gp_output_close(dm_gp_session *s, dm_err *e)
 
 int gp_output_commit(dm_gp_session *s, dm_err *e)
 {
-  int rc = DM_OK;
-  if (s->out_tmp == NULL)
-    return DM_OK;
-  if (rename(s->out_tmp, s->out_final) != 0) {
-    rc = dm_err_set(e, DM_EIO, "cannot rename the finished plot to '%.200s': "
-                    "%s", s->out_final, strerror(errno));
-    unlink(s->out_tmp);
-  }
-  free(s->out_tmp);
-  free(s->out_final);
-  s->out_tmp = s->out_final = NULL;
-  return rc;
+  s->out_open = 0;
+  return dm_outfile_commit(&s->out, e);
 }
 
 void gp_output_discard(dm_gp_session *s)
 {
-  if (s->out_tmp != NULL)
-    unlink(s->out_tmp);
-  free(s->out_tmp);
-  free(s->out_final);
-  s->out_tmp = s->out_final = NULL;
+  dm_outfile_abandon(&s->out);
   s->out_open = 0;
 }
 

@@ -54,7 +54,7 @@ local bad = {
   {function() dm.plot{ {x, y}, terminal = "png; system('x')", output = out } end,
    "terminal 'png; system%('x'%)': only plain words", "terminal with a command"},
   {function() dm.plot{ {x, y}, terminal = "nosuchterm", output = out } end, "no terminal 'nosuchterm'", "unknown terminal"},
-  {function() dm.plot{ {x, y}, output = dir .. "/no/such/dir/x.png" } end, "cannot create '.*no/such/dir/x%.png'", "missing directory"},
+  {function() dm.plot{ {x, y}, output = dir .. "/no/such/dir/x.png" } end, "plot output '.*no/such/dir/x%.png': cannot create a temporary file next to it: No such file or directory", "missing directory"},
   {function() dm.figure{}:splot{ {x, y} } end, "splot needs three", "splot with two columns"},
   {function() dm.figure{}:append(1, 1, 2) end, "no series 1", "append to a missing series"},
 }
