@@ -523,12 +523,14 @@ static const dm_reg integ_methods[] = {
    "One step from {q=, p=} or {q=, v=} (t optional) to a new state {t, q, p, v}; a Newton "
    "failure returns nil and a message with the residual and tolerance."},
   {"run", dm_linteg_run,
-   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=}) -> traj[, message]",
+   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=, max_energy_error=}) -> traj[, message]",
    "Integrate in C to step `steps` or time t, recording every `every` steps a Trajectory with "
-   "t, q, p, v, energy and momentum_<coord> columns (cyclic coordinates by default); Ctrl-C or a "
-   "failure (Newton, NaN) returns the trajectory so far and a second value, a message saying at "
-   "which step and time it stopped (with the residual and tolerance); progress (default: stdout "
-   "is a terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update."},
+   "t, q, p, v, energy and momentum_<coord> columns (cyclic coordinates by default); Ctrl-C, a "
+   "failure (Newton, domain) or a runaway (non-finite state or energy; |E - E0| > "
+   "max_energy_error max(1, |E0|) when given) returns the trajectory so far and a second value, "
+   "a message saying at which step and time it stopped; traj:meta() records method, stages, h, "
+   "order, steps, status and message; progress (default: stdout is a terminal) shows a line on "
+   "stderr for runs over 0.5 s, chunk= fixes its steps per update."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
    "step equations (exact Jacobians)."},
