@@ -463,7 +463,7 @@ static int r_index(lua_State *L)
     lua_pushinteger(L, (lua_Integer)x->n);
   else
     return luaL_error(L, "Routh reduction has no field or method '%s' (fields: %s; methods: "
-                      "set_mu, project, lift, reconstruct, phase, eval, psi, defect, integrator)",
+                      "set_mu, project, lift, reconstruct, phase, eval, discrete, defect, integrator)",
                       k, fields);
   return 1;
 }
@@ -572,6 +572,7 @@ void dm_open_reduce(lua_State *L)
   if (dm_routh_register_integrators(&e) != DM_OK)
     luaL_error(L, "dm.routh: %s", e.msg);
   dm_lrouth_open_boxes(L);
+  dm_lrouth_open_discrete(L);
   dm_newclass(L, DM_ROUTH_MT, "routh", dm_lrouth_methods, meta);
   lua_getfield(L, -1, "__methods");
   lua_pushcclosure(L, r_index, 1);

@@ -1,7 +1,8 @@
 /* l_reduce.h -- private glue of the Routh reduction binding: l_reduce.c
  * (dm.routh, fields, formulas) and
  * l_reduce_ops.c (methods: set_mu, project, lift, reconstruct, phase, eval,
- * psi, defect, integrator).  Not for other bindings.
+ * defect, integrator) and l_reduce_dr.c (red:discrete: the two-point
+ * discrete Routh equations).  Not for other bindings.
  *
  * A Routh reduction is a userdata "dmech.routh" (dm_lrouth) whose user
  * value 1 is the reduced System userdata -- it owns the dm_routh (its
@@ -34,5 +35,8 @@ void dm_lrouth_integrator(lua_State *L, int idx, int opts);
 
 extern const dm_reg dm_lrouth_methods[];
 void dm_lrouth_open_boxes(lua_State *L);   /* l_reduce_ops.c */
+/* red:discrete{...} and the class of its result (l_reduce_dr.c) */
+int dm_lrouth_discrete(lua_State *L);
+void dm_lrouth_open_discrete(lua_State *L);
 
 #endif

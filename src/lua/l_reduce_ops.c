@@ -1,6 +1,6 @@
 /* l_reduce_ops.c -- methods of a Routh reduction (see l_reduce.h):
  * red:set_mu, red:project, red:lift, red:reconstruct, red:phase, red:eval,
- * red:psi, red:defect, red:integrator.  Scratch memory lives in userdata, so
+ * red:defect, red:integrator (red:discrete is in l_reduce_dr.c).  Scratch memory lives in userdata, so
  * an argument error never leaks; C integrators made here are boxed in a
  * userdata whose __gc frees them. */
 #include <config.h>
@@ -358,45 +358,6 @@ static int m_eval(lua_State *L)
   return 1;
 }
 
-static int m_psi(lua_State *L)
-{
-  dm_lrouth *u = dm_lrouth_check(L, 1);
-  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
-  dm_lsystem *rs = sys_of(L, 1, 1);
-  size_t s = x->s;
-  double *buf = scratch_top(L, 5, 2 * s), psi[DM_ROUTH_RMAX], h = luaL_checknumber(L, 4);
-  const char *method = "midpoint";
-  int stages = 2, st;
-  dm_tableau *t = NULL;
-  dm_routh_dr *dr = NULL;
-  dm_err e;
-  dm_lua_system_readvec(L, rs, 2, "x0", buf);
-  dm_lua_system_readvec(L, rs, 3, "x1", buf + s);
-  if (!lua_isnoneornil(L, 5)) {
-    luaL_checktype(L, 5, LUA_TTABLE);
-    method = dm_optstringfield(L, 5, "method", method);
-    stages = (int)dm_optintegerfield(L, 5, "stages", stages);
-  }
-  if (strcmp(method, "gauss") == 0)
-    st = dm_tableau_gauss((size_t)stages, &t, &e);
-  else if (strcmp(method, "lobatto") == 0)
-    st = dm_tableau_lobatto((size_t)stages, &t, &e);
-  else if (strcmp(method, "midpoint") == 0)
-    st = DM_OK;
-  else
-    return luaL_error(L, "psi: method must be midpoint, gauss or lobatto, got '%s'", method);
-  if (st == DM_OK)
-    st = dm_routh_dr_alloc(u->red, t, 0, 0, &dr, &e);
-  if (st == DM_OK)
-    st = dm_routh_dr_psi(dr, h, buf, buf + s, psi, NULL, &e);
-  dm_routh_dr_free(dr);
-  dm_tableau_free(t);
-  if (st != DM_OK)
-    return dm_lua_fail(L, "psi", st, &e);
-  dm_lrouth_push_numbers(L, psi, x->r);
-  return 1;
-}
-
 static int m_defect(lua_State *L)
 {
   dm_lrouth *u = dm_lrouth_check(L, 1);
@@ -458,9 +419,11 @@ const dm_reg dm_lrouth_methods[] = {
    "geometric part -sum A(xbar) dx (midpoint rule); gap is the loop's closure defect."},
   {"eval", m_eval, "red:eval(x[, xdot]) -> {I=, Iinv=, A=, B=, Mtilde=, amended=, routhian=, ...}",
    "Numerical values of the derived objects at a shape point with the current mu."},
-  {"psi", m_psi, "red:psi(x0, x1, h[, {method = \"midpoint\" | \"gauss\" | \"lobatto\", stages=}]) -> dtheta",
-   "The discrete reconstruction psi_mu(x0, x1): the group step with discrete momentum J_d = mu "
-   "(closed form for the midpoint rule, Newton for Galerkin)."},
+  {"discrete", dm_lrouth_discrete,
+   "red:discrete{method = \"midpoint\" | \"gauss\" | \"lobatto\", stages =, h =} -> discrete",
+   "The discrete Routh equations of the midpoint or Galerkin discrete Lagrangian of the full "
+   "system in two-point form: psi_mu, the reduced discrete Lagrangian Lhat, its Legendre "
+   "transforms, the DR residual and solve, reconstruction of tangent vectors."},
   {"defect", m_defect, "red:defect(reduced_state, {method=, stages=, h=}) -> number",
    "Non-canonical symplecticity defect |DPhi^T W(x1) DPhi - W(x0)| of one reduced step, "
    "W = [[-B, I], [-I, 0]] (the form Omega_S - beta_mu)."},

@@ -199,11 +199,72 @@ do
   T.ok(d <= 1e-13, ("... and of the discrete Routh step, with its exact Jacobian (%.2g)"):format(d))
 end
 do
-  local psi_m = rd:psi({0.6, 0.5, 0.3}, {0.6031, 0.4962, 0.3118}, 0.05)
-  local psi_g = rd:psi({0.6, 0.5, 0.3}, {0.6031, 0.4962, 0.3118}, 0.05, {method = "gauss", stages = 1})
+  local x0, x1 = {0.6, 0.5, 0.3}, {0.6031, 0.4962, 0.3118}
+  local psi_m, D1m, D2m = rd:discrete{h = 0.05}:psi(x0, x1)
+  local psi_g, D1g, D2g = rd:discrete{method = "gauss", stages = 1, h = 0.05}:psi(x0, x1)
   T.near(psi_m, psi_g, 1e-15, "psi_mu: midpoint closed form = Galerkin-Gauss 1")
+  local dd = 0
+  for i = 1, 3 do dd = math.max(dd, math.abs(D1m[i] - D1g[i]), math.abs(D2m[i] - D2g[i])) end
+  T.ok(dd <= 1e-13, ("D1psi, D2psi: closed form = Galerkin-Gauss 1 (%.2g)"):format(dd))
   local dyn, geo, gap = rd:phase(tr)
   T.ok(dyn > 0 and math.abs(geo) > 0 and gap > 0, ("phase split: dynamic %.6f, geometric %.6f"):format(dyn, geo))
+end
+
+-- the discrete Routh equations in two-point form (red:discrete) -----------------
+do
+  local h = 0.02
+  local D = rd:discrete{method = "gauss", stages = 2, h = h}
+  T.ok(tostring(D):find("gauss s=2 h=0.02", 1, true), "tostring: " .. tostring(D))
+  local F = dm.integrator(dsp, {method = "gauss", stages = 2, h = h})
+  local function shape(q) return {q[2], q[3], q[4]} end
+  local s1 = F:step({q = q0, v = v0})            -- (q0, q1) on J_d = mu
+  local qa, qb = dm.vec(q0), s1.q
+  local xa, xb = shape(qa), shape(qb)
+  -- Lhat and the Legendre transforms against the full discrete Lagrangian
+  local psi = D:psi(xa, xb)
+  local p0, p1, Ld = F:dlegendre({0, xa[1], xa[2], xa[3]}, {psi, xb[1], xb[2], xb[3]})
+  local Lh, forms = D:lhat(xa, xb)
+  T.near(Lh, Ld, 1e-14, ("Lhat(x0, x1) = L_d((0, x0), (psi_mu, x1)) = %.10g"):format(Lh))
+  T.near(p1[1], rd.mu, 1e-13, "J_d((0, x0), (psi_mu, x1)) = mu")
+  local sm, sp = D:legendre(xa, xb)
+  local proj = rd:project{q = qb, p = s1.p}
+  local dl = 0
+  for i = 1, 3 do dl = math.max(dl, math.abs(sp[i] - proj.p[i])) end
+  T.ok(dl <= 1e-12, ("F+ Lhat(x0, x1) = projected momentum p_x - mu^T A at q1 (%.2g)"):format(dl))
+  T.ok(#forms.D1 == 3 and #forms.A2 == 3, "lhat returns D1, D2, A1, A2")
+  -- Theorem: the DEL trajectory projected solves the DR equations, and the
+  -- DR recursion from the same (x0, x1) reproduces it
+  local ya, yb = xa, xb
+  local worst, rmax = 0, 0
+  for k = 1, 100 do
+    local qc = F:del_step(qa, qb)
+    local yc = D:solve(ya, yb)
+    local xc = shape(qc)
+    for i = 1, 3 do worst = math.max(worst, math.abs(yc[i] - xc[i])) end
+    local rdr, rdel = D:residual(shape(qa), shape(qb), xc)
+    for i = 1, 3 do rmax = math.max(rmax, math.abs(rdr[i]), math.abs(rdel[i])) end
+    qa, qb, ya, yb = qb, qc, yb, yc
+  end
+  T.ok(worst <= 1e-11, ("DR recursion = projected DEL trajectory over 100 steps (%.2g)"):format(worst))
+  T.ok(rmax <= 1e-11, ("DR residual and shape part of DEL vanish along DEL (%.2g)"):format(rmax))
+  -- reconstruction of tangent vectors: ((dth0, dx0), (dth1, dx1)) is tangent
+  -- to J_d = mu (its derivative along the variation vanishes), dth1 = dth0 is not
+  local dx0, dx1, dth0 = {0.31, -0.17, 0.42}, {-0.23, 0.29, 0.11}, 0.37
+  local dth1 = D:dtheta(xa, xb, dth0, dx0, dx1)
+  local th1 = D:psi(xa, xb)
+  local function Jd(eps, d1)
+    local a = {eps * dth0, xa[1] + eps * dx0[1], xa[2] + eps * dx0[2], xa[3] + eps * dx0[3]}
+    local b = {th1 + eps * d1, xb[1] + eps * dx1[1], xb[2] + eps * dx1[2], xb[3] + eps * dx1[3]}
+    return F:discrete_momentum(a, b, "theta")
+  end
+  local eps = 1e-6
+  local dJ = (Jd(eps, dth1) - Jd(-eps, dth1)) / (2 * eps)
+  local dJ0 = (Jd(eps, dth0) - Jd(-eps, dth0)) / (2 * eps)
+  T.ok(math.abs(dJ) <= 1e-7 and math.abs(dJ0) > 1e-2,
+       ("dtheta1 = dtheta0 + D1psi dx0 + D2psi dx1 keeps J_d = mu to first order (dJ_d %.2g; with dtheta1 = dtheta0: %.2g)"):format(dJ, dJ0))
+  T.error_like(function() rd:discrete{method = "prk", h = 0.1} end, "method must be \"midpoint\", \"gauss\" or \"lobatto\"", "discrete: bad method")
+  T.error_like(function() rd:discrete{method = "gauss"} end, "option 'h' %(a finite non%-zero step%) is required", "discrete: h required")
+  T.error_like(function() rd:discrete{h = 0.1, tol = 1} end, "unknown option tol", "discrete: unknown option")
 end
 
 -- parameters: a change through the reduced system reaches every method -----------
