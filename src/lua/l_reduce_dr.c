@@ -239,7 +239,7 @@ static int ldr_tostring(lua_State *L)
     lua_pushliteral(L, "<discrete Routh (closed)>");
     return 1;
   }
-  dm_fmtnum(num, sizeof num, D->h);
+  dm_num_format(num, sizeof num, D->h);
   lua_pushfstring(L, "<discrete Routh '%s': %s", dm_routh_system(D->red)->name, D->method);
   if (strcmp(D->method, "midpoint") != 0)
     lua_pushfstring(L, " s=%d", D->stages);
