@@ -144,6 +144,10 @@ void dm_open_lie(lua_State *L);         /* dm.lie: Lie groups, systems on groups
 /* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
  * bindings whose objects make integrators (red:integrator). */
 int dm_lua_integrator(lua_State *L);
+/* The C integrator of the Integrator userdata at idx (rebuilt first after
+ * a parameter change); raises when it is not an open Integrator.  The
+ * userdata owns it: keep the userdata on the stack while using it. */
+struct dm_integrator *dm_lua_tointegrator(lua_State *L, int idx);
 void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
 
 /* ---- module opener ------------------------------------------------------------ */

@@ -217,6 +217,7 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
 {
   const dm_integrator_type *type;
   dm_err e;
+  int given;
   idx = lua_absindex(L, idx);
   dm_integ_opts_init(opt);
   *method = "gauss";
@@ -268,7 +269,12 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
     }
     lua_pop(L, 1);
   }
-  if (in_list(type->options, "tableau")) {
+  /* families with a user tableau among other methods (the reduced ones)
+   * read it only when given; "prk" itself requires it */
+  lua_getfield(L, idx, "tableau");
+  given = !lua_isnil(L, -1);
+  lua_pop(L, 1);
+  if (in_list(type->options, "tableau") && (given || strcmp(type->name, "prk") == 0)) {
     opt->tableau = parse_tableau(L, idx, fname);
   } else {
     lua_pushnil(L);

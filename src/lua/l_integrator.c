@@ -51,6 +51,11 @@ dm_linteg *dm_linteg_check(lua_State *L, int idx)
   return li;
 }
 
+dm_integrator *dm_lua_tointegrator(lua_State *L, int idx)
+{
+  return dm_linteg_check(L, idx)->I;
+}
+
 dm_lsystem *dm_linteg_checksystem(lua_State *L, int idx)
 {
   dm_lsystem *ls = dm_lua_tosystem(L, idx);

@@ -571,7 +571,6 @@ void dm_open_reduce(lua_State *L)
   dm_err e;
   if (dm_routh_register_integrators(&e) != DM_OK)
     luaL_error(L, "dm.routh: %s", e.msg);
-  dm_lrouth_open_boxes(L);
   dm_lrouth_open_discrete(L);
   dm_newclass(L, DM_ROUTH_MT, "routh", dm_lrouth_methods, meta);
   lua_getfield(L, -1, "__methods");

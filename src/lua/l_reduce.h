@@ -34,7 +34,6 @@ void dm_lrouth_read_mu(lua_State *L, int idx, size_t r, double *mu, const char *
 void dm_lrouth_integrator(lua_State *L, int idx, int opts);
 
 extern const dm_reg dm_lrouth_methods[];
-void dm_lrouth_open_boxes(lua_State *L);   /* l_reduce_ops.c */
 /* red:discrete{...} and the class of its result (l_reduce_dr.c) */
 int dm_lrouth_discrete(lua_State *L);
 void dm_lrouth_open_discrete(lua_State *L);

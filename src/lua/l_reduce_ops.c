@@ -1,8 +1,8 @@
 /* l_reduce_ops.c -- methods of a Routh reduction (see l_reduce.h):
  * red:set_mu, red:project, red:lift, red:reconstruct, red:phase, red:eval,
- * red:defect, red:integrator (red:discrete is in l_reduce_dr.c).  Scratch memory lives in userdata, so
- * an argument error never leaks; C integrators made here are boxed in a
- * userdata whose __gc frees them. */
+ * red:defect, red:integrator (red:discrete is in l_reduce_dr.c).  Scratch
+ * memory lives in userdata, so an argument error never leaks; integrators
+ * are made by dm.integrator (one option parser) and live on the stack. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>
@@ -10,7 +10,6 @@
 
 #include "lua/l_reduce.h"
 
-#define IBOX_MT "dmech.routh.ibox"
 
 /* scratch doubles owned by a new userdata (pushed) */
 static double *scratch(lua_State *L, size_t n)
@@ -36,52 +35,50 @@ static dm_lsystem *sys_of(lua_State *L, int idx, int uv)
   return ls;
 }
 
-/* {==== integrator boxes ================================================= */
+/* {==== integrators for reconstruct and defect ========================== */
 
-static int ibox_gc(lua_State *L)
+/* dm.integrator(red, opts') pushed, its C integrator returned: opts' holds
+ * the defaults (method, stages, h from `defaults`, a table index or 0)
+ * when the options table at `opts` (or 0) names no method, then every
+ * option of `opts` except those in skip.  *h: opts'.h or NAN.  Option
+ * errors are the integrator's own. */
+static dm_integrator *reduced_integrator(lua_State *L, int self, int opts, int defaults,
+                                         const char *const *skip, double *h)
 {
-  dm_integrator **pp = luaL_checkudata(L, 1, IBOX_MT);
-  dm_integrator_free(*pp);
-  *pp = NULL;
-  return 0;
-}
-
-/* method = opts.method or def, stages, h from the table at opts
- * (0: none); pushes the box; *h gets opts.h or NAN */
-static dm_integrator *boxed_integrator(lua_State *L, dm_routh *red, int opts, const char *def,
-                                       int def_stages, double *h, const char *fname)
-{
-  dm_integrator **pp = lua_newuserdatauv(L, sizeof *pp, 0);
-  dm_integ_opts o;
-  const char *method = def;
-  dm_err e;
-  int st;
-  *pp = NULL;
-  luaL_setmetatable(L, IBOX_MT);
-  dm_integ_opts_init(&o);
-  o.stages = def_stages;
-  *h = NAN;
-  if (opts) {
-    if (lua_getfield(L, opts, "method") == LUA_TSTRING)
-      method = lua_tostring(L, -1);
-    else if (!lua_isnil(L, -1))
-      luaL_error(L, "%s: option 'method' must be a string", fname);
+  const char *const *k;
+  int t, user_method = opts && lua_getfield(L, opts, "method") != LUA_TNIL;
+  if (opts)
     lua_pop(L, 1);
-    if (lua_getfield(L, opts, "stages") != LUA_TNIL)
-      o.stages = (int)luaL_checkinteger(L, -1);
-    lua_pop(L, 1);
-    if (lua_getfield(L, opts, "h") != LUA_TNIL)
-      *h = luaL_checknumber(L, -1);
-    lua_pop(L, 1);
+  lua_pushcfunction(L, dm_lua_integrator);
+  lua_pushvalue(L, self);
+  lua_newtable(L);
+  t = lua_gettop(L);
+  if (defaults && !user_method) {
+    lua_pushnil(L);
+    while (lua_next(L, defaults) != 0) {
+      lua_pushvalue(L, -2);
+      lua_insert(L, -2);
+      lua_settable(L, t);
+    }
   }
-  if (strcmp(method, "midpoint") == 0 || strcmp(method, "trapezoid") == 0
-      || strcmp(method, "dr") == 0 || strcmp(method, "dr:midpoint") == 0
-      || strcmp(method, "classical:midpoint") == 0 || strcmp(method, "classical:trapezoid") == 0)
-    o.stages = 0;
-  st = dm_routh_integrator_new(red, method, &o, pp, &e);
-  if (st != DM_OK)
-    dm_lua_fail(L, fname, st, &e);
-  return *pp;
+  if (opts) {
+    lua_pushnil(L);
+    while (lua_next(L, opts) != 0) {
+      for (k = skip; *k && !(lua_type(L, -2) == LUA_TSTRING && strcmp(*k, lua_tostring(L, -2)) == 0); k++)
+        ;
+      if (*k) {
+        lua_pop(L, 1);
+        continue;
+      }
+      lua_pushvalue(L, -2);
+      lua_insert(L, -2);
+      lua_settable(L, t);
+    }
+  }
+  *h = lua_getfield(L, t, "h") == LUA_TNUMBER ? lua_tonumber(L, -1) : NAN;
+  lua_pop(L, 1);
+  lua_call(L, 2, 1);
+  return dm_lua_tointegrator(L, -1);
 }
 
 /* }====================================================================== */
@@ -238,29 +235,44 @@ static int m_lift(lua_State *L)
   return 1;
 }
 
+/* defaults {method =, stages =, h =} from the run that made traj (pushed) */
+static void run_defaults(lua_State *L, const dm_traj *rt)
+{
+  const char *m = dm_traj_meta_get(rt, "method");
+  double x;
+  lua_createtable(L, 0, 3);
+  if (m != NULL) {
+    lua_pushstring(L, m);
+    lua_setfield(L, -2, "method");
+  }
+  if (dm_traj_meta_number(rt, "stages", &x)) {
+    lua_pushinteger(L, (lua_Integer)x);
+    lua_setfield(L, -2, "stages");
+  }
+  if (dm_traj_meta_number(rt, "h", &x)) {
+    lua_pushnumber(L, x);
+    lua_setfield(L, -2, "h");
+  }
+}
+
 static int m_reconstruct(lua_State *L)
 {
+  static const char *const skip[] = {"theta", NULL};
   dm_lrouth *u = dm_lrouth_check(L, 1);
   dm_traj *rt = dm_checktraj(L, 2);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   dm_integrator *I;
   dm_traj **slot, *out = NULL;
   double th[DM_ROUTH_RMAX], h;
-  const char *meta;
-  char method[2 * DM_INTEG_STRMAX] = "gauss";
-  int stages = 0, st, opts = lua_isnoneornil(L, 3) ? 0 : 3;
+  int st, opts = lua_isnoneornil(L, 3) ? 0 : 3;
   dm_err e;
   if (opts)
     luaL_checktype(L, 3, LUA_TTABLE);
-  /* defaults from the run that produced the trajectory */
-  if ((meta = dm_traj_meta_get(rt, "method")) != NULL)
-    snprintf(method, sizeof method, "%s", strncmp(meta, "routh:", 6) == 0 ? meta + 6 : meta);
-  if ((meta = dm_traj_meta_get(rt, "stages")) != NULL)
-    stages = atoi(meta);
-  lua_pushstring(L, method);                                   /* anchors the default */
-  I = boxed_integrator(L, u->red, opts, lua_tostring(L, -1), stages, &h, "reconstruct");
+  lua_settop(L, 3);
+  run_defaults(L, rt);                                          /* 4 */
+  I = reduced_integrator(L, 1, opts, 4, skip, &h);              /* 5 */
   if (isnan(h))
-    h = (meta = dm_traj_meta_get(rt, "h")) != NULL ? atof(meta) : 0.0;
+    h = 0.0;
   if (opts)
     lua_getfield(L, 3, "theta");
   else
@@ -360,6 +372,7 @@ static int m_eval(lua_State *L)
 
 static int m_defect(lua_State *L)
 {
+  static const char *const skip[] = {NULL};
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   size_t s = x->s;
@@ -369,8 +382,8 @@ static int m_defect(lua_State *L)
   int st;
   read_reduced_state(L, u, 1, 2, buf, buf + s, NULL, "defect");
   luaL_checktype(L, 3, LUA_TTABLE);
-  I = boxed_integrator(L, u->red, 3, "gauss", 2, &h, "defect");
-  if (isnan(h) || h == 0.0)
+  I = reduced_integrator(L, 1, 3, 0, skip, &h);
+  if (isnan(h))
     return luaL_error(L, "defect: give the step h in the options");
   if ((st = dm_routh_symplecticity_defect(I, h, buf, buf + s, &def, &e)) != DM_OK)
     return dm_lua_fail(L, "defect", st, &e);
@@ -431,12 +444,3 @@ const dm_reg dm_lrouth_methods[] = {
    "Same as dm.integrator(red, opts): RSPRK, dr or classical on the reduced system."},
   {NULL, NULL, NULL, NULL}
 };
-
-static const luaL_Reg ibox_meta[] = {{"__gc", ibox_gc}, {NULL, NULL}};
-
-void dm_lrouth_open_boxes(lua_State *L)
-{
-  luaL_newmetatable(L, IBOX_MT);
-  luaL_setfuncs(L, ibox_meta, 0);
-  lua_pop(L, 1);
-}

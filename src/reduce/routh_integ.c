@@ -38,6 +38,9 @@ typedef struct rinteg {
 static const dm_integrator_type rsprk_type, dr_type, classical_type;
 
 static const char *const routh_options[] = {"stages", "h", "tol", "maxiter", "simplified", NULL};
+/* RSPRK and classical also take a user tableau (method prk) */
+static const char *const tableau_options[] = {"stages", "h", "tol", "maxiter", "simplified",
+                                              "tableau", NULL};
 static const char *const routh_kinds[] = {DM_ROUTH_KIND, NULL};
 static const char *const rsprk_names[] = {"gauss", "midpoint", "lobatto", "trapezoid", "prk", NULL};
 
@@ -52,6 +55,8 @@ static int muA_at(rinteg *R, const double *x, double *a, dm_err *e)
 static int make_tableau(const char *fam, const dm_integ_opts *o, dm_tableau **t, dm_err *e)
 {
   *t = NULL;
+  if (o->tableau != NULL && strcmp(fam, "prk") != 0)
+    return dm_err_set(e, DM_EINVAL, "option 'tableau' is for method 'prk' (got method '%s')", fam);
   if (strcmp(fam, "gauss") == 0)
     return dm_tableau_gauss(o->stages ? (size_t)o->stages : 2, t, e);
   if (strcmp(fam, "midpoint") == 0) {
@@ -417,7 +422,7 @@ static const dm_integrator_type rsprk_type = {
     "magnetic term in the Newton matrix",
   .order = 0,
   .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  .options = routh_options,
+  .options = tableau_options,
   .alloc = rsprk_alloc,
   .step = rsprk_step,
   .jacobian = rsprk_jacobian,
@@ -448,7 +453,7 @@ static const dm_integrator_type classical_type = {
     "classical (= classical:gauss), classical:<gauss|midpoint|lobatto|trapezoid|prk>",
   .order = 0,
   .flags = DM_INTEG_SYMPLECTIC | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS | DM_INTEG_EXACT_JAC,
-  .options = routh_options,
+  .options = tableau_options,
   .alloc = classical_alloc,
   .step = classical_type_step,
   .jacobian = classical_type_jacobian,

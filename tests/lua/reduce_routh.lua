@@ -191,6 +191,32 @@ do
   T.ok(dphi <= 1e-11, ("reduced run from the projected state reconstructs the unreduced phi (diff %.2g)"):format(dphi))
 end
 
+-- the run records its method, stages and h: reconstruct uses them (a Gauss
+-- s = 3 run was rebuilt with s = 2: theta off by 5e-5 at h = 0.02)
+do
+  local st3 = rd:project{q = q0, v = v0}
+  local t3 = dm.integrator(rd, {method = "gauss", stages = 3, h = 0.02}):run(st3, {steps = 200, every = 20})
+  T.ok(t3:meta("stages") == 3 and math.type(t3:meta("stages")) == "integer" and t3:meta("h") == 0.02,
+       "reduced run metadata: stages and h as numbers")
+  local f3 = rd:reconstruct(t3, {theta = 0.3})
+  local u3 = dm.integrator(dsp, {method = "gauss", stages = 3, h = 0.02}):run({q = q0, v = v0}, {steps = 200, every = 20})
+  local d3 = maxdiff(f3, u3, {"theta", "r1", "phi"})
+  T.ok(d3 <= 1e-12, ("reconstruct of a Gauss s = 3 run with the run's stages = unreduced Gauss 3 (%.2g)"):format(d3))
+  -- a user tableau: reduced prk and classical:prk
+  local g3 = dm.tableau("gauss", 3)
+  local tp = dm.integrator(rd, {method = "prk", tableau = g3, h = 0.02}):run(st3, {steps = 200, every = 20})
+  local tc3 = dm.integrator(rd, {method = "classical:prk", tableau = g3, h = 0.02}):run(st3, {steps = 200, every = 20})
+  T.ok(maxdiff(tp, t3, cols) <= 1e-12 and maxdiff(tc3, t3, cols) <= 1e-12,
+       ("RSPRK and classical SPRK with the Gauss 3 tableau given by hand = RSPRK gauss s = 3 (%.2g, %.2g)")
+       :format(maxdiff(tp, t3, cols), maxdiff(tc3, t3, cols)))
+  local fp = rd:reconstruct(tp, {theta = 0.3, tableau = g3})
+  T.ok(maxdiff(fp, u3, {"theta", "r1"}) <= 1e-12, "reconstruct of a prk run with its tableau")
+  T.error_like(function() dm.integrator(rd, {method = "prk", h = 0.02}) end, "dm.integrator: method 'prk' needs a tableau",
+    "reduced prk without a tableau")
+  T.error_like(function() dm.integrator(rd, {method = "gauss", tableau = g3, h = 0.02}) end,
+    "option 'tableau' is for method 'prk' %(got method 'gauss'%)", "a tableau with another method is an error, not ignored")
+end
+
 -- structure --------------------------------------------------------------------
 T.ok(rd:defect(st, {method = "gauss", stages = 3, h = 0.05}) <= 1e-10, "non-canonical symplecticity defect of RSPRK Gauss 3")
 T.ok(rd:defect(st, {method = "classical", stages = 2, h = 0.05}) <= 1e-10, "... and of the classical SPRK pulled back")
