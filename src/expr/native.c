@@ -2,6 +2,7 @@
  * it, check it against the tape, cache the object.  See native.h. */
 #include <config.h>
 #include "core/numfmt.h"
+#include "core/cleanup.h"
 #include "expr/native_impl.h"
 
 #include <dlfcn.h>
@@ -564,7 +565,12 @@ static int compile_native(const dm_tape *t, const double *in0,
   int have_cache = dm_native__cache_dir(cdir, sizeof cdir) == 0;
   if (have_cache) {
     snprintf(cached, sizeof cached, "%s/%s.so", cdir, nat->key);
-    if (dm_native__trusted_file(cached) && load(cached, nat->key, nat, NULL) == DM_OK) {
+    /* loaded only when its content matches the digest recorded when it
+     * was stored: a damaged object is never executed */
+    char lpath[4200];
+    int cfd = dm_native__cache_open(cached, lpath, sizeof lpath);
+    if (cfd >= 0 && load(lpath, nat->key, nat, NULL) == DM_OK) {
+      close(cfd);
       if (verify(t, nat, in0, par0, NULL) == DM_OK) {
         nat->cached = 1;
         return DM_OK;
@@ -572,6 +578,8 @@ static int compile_native(const dm_tape *t, const double *in0,
       dlclose(nat->dl);                /* stale or damaged: rebuild */
       nat->dl = NULL;
       unlink(cached);
+    } else if (cfd >= 0) {
+      close(cfd);
     }
   }
 
@@ -593,6 +601,7 @@ static int compile_native(const dm_tape *t, const double *in0,
     return dm_err_set(err, DM_EIO, "native: mkdtemp in %s: %s",
                       tmpd && *tmpd ? tmpd : "/tmp", strerror(errno));
   }
+  int dslot = dm_cleanup_add_dir(dir);     /* removed at exit or SIGTERM too */
   s = dm_native__build(ccargv, ncc, dir, full, obj, sizeof obj, err);
   free(full);
   if (s == DM_OK) {
@@ -603,6 +612,7 @@ static int compile_native(const dm_tape *t, const double *in0,
       s = load(obj, nat->key, nat, err);
   }
   dm_native__remove_tree(dir);
+  dm_cleanup_drop(dslot);
   if (s != DM_OK)
     return s;
   return verify(t, nat, in0, par0, err);

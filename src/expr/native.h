@@ -15,15 +15,19 @@
  * NaN).  Objects are cached under $XDG_CACHE_HOME/dmech (else
  * ~/.cache/dmech; directory 0700, files 0600, written to a temporary name
  * and renamed) keyed by the SHA-256 of the emitted source, the compiler
- * command and its --version text; a cached object is loaded only when it is
- * a regular file owned by the user and not writable by others.  The
- * compiler runs through posix_spawn (never a shell); its stderr becomes the
- * error message.
+ * command and its --version text, with the SHA-256 of the object itself
+ * beside it (<key>.so.sha256); a cached object is loaded only when it is a
+ * regular file owned by the user, not writable by others, and its content
+ * has that digest (else it is rebuilt and replaced).  The compiler runs
+ * through posix_spawn (never a shell) in a process group of its own, which
+ * is killed whole on an interrupt, on the timeout and (through
+ * core/cleanup.h) on exit or SIGTERM; the build directory is removed on
+ * every path.  Its stderr becomes the error message.
  *
  * Errors (the caller then uses the tape): DM_ENOTFOUND no compiler,
  * DM_EFAILED compilation failed or the code disagrees with the tape,
  * DM_EIO file or dlopen trouble, DM_EINTR interrupted, DM_ETIMEOUT the
- * compiler ran longer than 300 s.  Nothing is printed.
+ * compiler ran longer than $DMECH_CC_TIMEOUT seconds (default 300).  Nothing is printed.
  *
  * Ownership: dm_native_compile allocates, dm_native_free releases (NULL
  * ok); the loaded code stays valid until then and does not refer to the

@@ -15,9 +15,13 @@ int dm_native__make_key(char **ccargv, int ncc, const char *src, char key[65],
                         dm_err *err);
 /* The private cache directory (created 0700), or -1 when there is none. */
 int dm_native__cache_dir(char *dir, size_t size);
-/* 1 if path is a regular file of ours that others cannot write. */
-int dm_native__trusted_file(const char *path);
-/* Copy obj into the cache as final (temporary name, 0600, rename). */
+/* Open a cached object whose content matches its recorded SHA-256 (and
+ * that is a regular file of ours others cannot write): descriptor (close
+ * after dlopen) and the name to dlopen in lpath; -1 when it must be
+ * rebuilt. */
+int dm_native__cache_open(const char *path, char *lpath, size_t size);
+/* Copy obj into the cache as final with its digest final.sha256
+ * (temporary names, 0600, rename). */
 int dm_native__cache_store(const char *dir, const char *final, const char *obj);
 /* Write src to dir/f.c and compile it to dir/f.so (path into obj). */
 int dm_native__build(char **ccargv, int ncc, const char *dir, const char *src,

@@ -3,6 +3,7 @@
  * and the object cache.  See native.h. */
 #include <config.h>
 #include "expr/native_impl.h"
+#include "core/cleanup.h"
 #include "core/interrupt.h"
 
 #include <errno.h>
@@ -21,7 +22,7 @@
 
 extern char **environ;
 
-#define CC_TIMEOUT 300.0      /* seconds */
+#define CC_TIMEOUT 300.0      /* seconds, unless $DMECH_CC_TIMEOUT says */
 
 
 /* {==================================================================
@@ -139,9 +140,25 @@ int dm_native__cc_words(char *copy, char **argv, int max)
   return k;
 }
 
+/* Seconds the compiler may run: $DMECH_CC_TIMEOUT, else CC_TIMEOUT. */
+static double cc_timeout(void)
+{
+  const char *env = getenv("DMECH_CC_TIMEOUT");
+  char *end;
+  double t = env != NULL ? strtod(env, &end) : 0;
+  return env != NULL && end != env && t > 0 && t < 1e6 ? t : CC_TIMEOUT;
+}
+
 /* Run argv with stdin from /dev/null and stdout + stderr captured into out
  * (at most size-1 bytes kept, NUL-terminated).  *status is the exit code
- * (128 + signal when killed).  Returns a dm status. */
+ * (128 + signal when killed).  Returns a dm status.
+ *
+ * The compiler runs in a process group of its own: the driver `cc` starts
+ * cc1, as, ld; on an interrupt or the timeout the whole group is killed
+ * (killing only the driver left cc1 running at full CPU), and the group is
+ * registered with core/cleanup.h so that SIGTERM or exit() kill it too.
+ * Being in its own group, the compiler does not see the terminal's Ctrl-C;
+ * dmech's interrupt flag stops it instead. */
 static int run(char *const argv[], char *out, size_t size, int *status,
                dm_err *err)
 {
@@ -149,15 +166,20 @@ static int run(char *const argv[], char *out, size_t size, int *status,
   if (pipe(fd) != 0)
     return dm_err_set(err, DM_EIO, "native: pipe: %s", strerror(errno));
   posix_spawn_file_actions_t fa;
+  posix_spawnattr_t attr;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_adddup2(&fa, fd[1], 1);
   posix_spawn_file_actions_adddup2(&fa, fd[1], 2);
   posix_spawn_file_actions_addclose(&fa, fd[0]);
   posix_spawn_file_actions_addclose(&fa, fd[1]);
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);
   pid_t pid;
-  int rc = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
+  int rc = posix_spawnp(&pid, argv[0], &fa, &attr, argv, environ);
   posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&attr);
   close(fd[1]);
   if (rc != 0) {
     close(fd[0]);
@@ -165,42 +187,65 @@ static int run(char *const argv[], char *out, size_t size, int *status,
                       "native: cannot run C compiler '%s': %s", argv[0],
                       strerror(rc));
   }
+  int slot = dm_cleanup_add_pgroup(pid);
   size_t len = 0;
-  int result = DM_OK;
-  double t0 = now();
+  int result = DM_OK, ws = 0, open = 1;
+  double t0 = now(), limit = cc_timeout();
   for (;;) {
-    struct pollfd p = { fd[0], POLLIN, 0 };
-    int k = poll(&p, 1, 50);
-    if (k > 0) {
-      char tmp[4096];
-      ssize_t r = read(fd[0], tmp, sizeof tmp);
-      if (r == 0)
-        break;
-      if (r > 0 && len + 1 < size) {
-        size_t m = (size_t)r < size - 1 - len ? (size_t)r : size - 1 - len;
-        memcpy(out + len, tmp, m);
-        len += m;
+    if (open) {
+      struct pollfd p = { fd[0], POLLIN, 0 };
+      if (poll(&p, 1, 50) > 0) {
+        char tmp[4096];
+        ssize_t r = read(fd[0], tmp, sizeof tmp);
+        if (r > 0 && len + 1 < size) {
+          size_t m = (size_t)r < size - 1 - len ? (size_t)r : size - 1 - len;
+          memcpy(out + len, tmp, m);
+          len += m;
+        }
+        open = r > 0 || (r < 0 && errno == EINTR);
       }
-      if (r < 0 && errno != EINTR)
-        break;
+    } else {
+      struct timespec ts = { 0, 10000000L };
+      nanosleep(&ts, NULL);
     }
-    if (dm_interrupted() || now() - t0 > CC_TIMEOUT) {
+    /* the driver may exit while a child still holds the pipe, or close
+     * the pipe and go on running: watch both */
+    pid_t w = waitpid(pid, &ws, WNOHANG);
+    if (w == pid)
+      break;
+    if (dm_interrupted() || now() - t0 > limit) {
       result = dm_interrupted() ? DM_EINTR : DM_ETIMEOUT;
-      kill(pid, SIGKILL);
+      kill(-pid, SIGKILL);
+      while (waitpid(pid, &ws, 0) < 0 && errno == EINTR)
+        ;
       break;
     }
   }
+  /* whatever the driver left in its group (nothing, normally) goes too;
+   * the group id stays reserved while any member lives */
+  kill(-pid, SIGKILL);
+  dm_cleanup_drop(slot);
+  while (open) {                 /* the rest of the output, if any */
+    char tmp[4096];
+    struct pollfd p = { fd[0], POLLIN, 0 };
+    ssize_t r = poll(&p, 1, 0) > 0 ? read(fd[0], tmp, sizeof tmp) : 0;
+    if (r > 0 && len + 1 < size) {
+      size_t m = (size_t)r < size - 1 - len ? (size_t)r : size - 1 - len;
+      memcpy(out + len, tmp, m);
+      len += m;
+    }
+    open = r > 0;
+  }
+  while (len > 0 && (out[len - 1] == '\n' || out[len - 1] == ' '))
+    len--;                       /* messages end without a newline */
   out[len] = '\0';
   close(fd[0]);
-  int ws;
-  while (waitpid(pid, &ws, 0) < 0 && errno == EINTR)
-    ;
   *status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
   if (result == DM_EINTR)
     return dm_err_set(err, DM_EINTR, "native: compilation interrupted");
   if (result == DM_ETIMEOUT)
-    return dm_err_set(err, DM_ETIMEOUT, "native: %s ran longer than %.0f s",
-                      argv[0], CC_TIMEOUT);
+    return dm_err_set(err, DM_ETIMEOUT, "native: %s ran longer than %g s",
+                      argv[0], limit);
   /* glibc reports a failed exec as exit status 127 */
   if (*status == 127 && len == 0)
     return dm_err_set(err, DM_ENOTFOUND, "native: cannot run C compiler '%s'",
@@ -295,47 +340,133 @@ int dm_native__cache_dir(char *dir, size_t size)
   return private_dir(dir);
 }
 
-/* A cached object is used only if it is a regular file of ours that
- * nobody else can write. */
-int dm_native__trusted_file(const char *path)
+/* The digest of an object is kept beside it as "<object>.sha256" (64 hex
+ * digits), written when the object is stored: a cached object whose
+ * content no longer matches (a damaged disk block, a truncated copy, an
+ * edit) is never handed to dlopen -- running it could raise SIGILL on
+ * every later start until the cache was deleted by hand. */
+static void digest_hex(const void *data, size_t n, char hex[65])
 {
-  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0)
-    return 0;
-  struct stat st;
-  int ok = fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
-           st.st_uid == getuid() && (st.st_mode & 022) == 0;
-  close(fd);
-  return ok;
+  sha256 h;
+  sha_init(&h);
+  sha_update(&h, data, n);
+  sha_hex(&h, hex);
 }
 
-/* Copy the object into the cache: temporary name, 0600, rename. */
-int dm_native__cache_store(const char *dir, const char *final, const char *obj)
+/* Write n bytes to a new private temporary in dir and rename it to final. */
+static int store_file(const char *dir, const char *final, const void *data,
+                      size_t n)
 {
-  size_t n;
-  char *data = read_file(obj, &n), tmp[4200];
-  if (data == NULL)
-    return -1;
+  char tmp[4200];
   snprintf(tmp, sizeof tmp, "%s/.tmp-XXXXXX", dir);
   int fd = mkstemp(tmp);
-  int bad = fd < 0;
+  if (fd < 0)
+    return -1;
+  int bad = 0;
   for (size_t off = 0; !bad && off < n;) {
-    ssize_t w = write(fd, data + off, n - off);
+    ssize_t w = write(fd, (const char *)data + off, n - off);
     if (w < 0 && errno == EINTR)
       continue;
     bad = w <= 0;
     off += bad ? 0 : (size_t)w;
   }
-  free(data);
-  if (fd >= 0) {
-    bad |= fchmod(fd, 0600) != 0;
-    bad |= close(fd) != 0;
-    if (bad || rename(tmp, final) != 0) {
-      unlink(tmp);
-      return -1;
-    }
+  bad |= fchmod(fd, 0600) != 0;
+  bad |= close(fd) != 0;
+  if (bad || rename(tmp, final) != 0) {
+    unlink(tmp);
+    return -1;
   }
-  return bad ? -1 : 0;
+  return 0;
+}
+
+/* Copy the object into the cache with its digest: temporary names, 0600,
+ * rename (the digest first: an object never appears without one). */
+int dm_native__cache_store(const char *dir, const char *final, const char *obj)
+{
+  size_t n;
+  char *data = read_file(obj, &n), sumpath[4300], hex[65];
+  if (data == NULL)
+    return -1;
+  digest_hex(data, n, hex);
+  snprintf(sumpath, sizeof sumpath, "%s.sha256", final);
+  int rc = store_file(dir, sumpath, hex, 64) == 0
+           && store_file(dir, final, data, n) == 0 ? 0 : -1;
+  free(data);
+  return rc;
+}
+
+/* Whole content of an open descriptor (malloc'ed), or NULL. */
+static char *read_fd(int fd, size_t *n)
+{
+  char *buf = NULL;
+  size_t len = 0, cap = 0;
+  for (;;) {
+    if (len == cap) {
+      char *p = realloc(buf, cap = cap ? 2 * cap : 65536);
+      if (p == NULL) {
+        free(buf);
+        return NULL;
+      }
+      buf = p;
+    }
+    ssize_t r = read(fd, buf + len, cap - len);
+    if (r < 0 && errno == EINTR)
+      continue;
+    if (r < 0) {
+      free(buf);
+      return NULL;
+    }
+    if (r == 0)
+      break;
+    len += (size_t)r;
+  }
+  *n = len;
+  return buf;
+}
+
+/* Open a cached object for loading: a regular file of ours that others
+ * cannot write, whose SHA-256 equals the recorded one.  Returns the open
+ * descriptor (close it after dlopen) and in lpath the name to give dlopen:
+ * /proc/self/fd/N when there is /proc, so the checked content is the
+ * loaded content; else the path.  -1 when the object must be rebuilt. */
+int dm_native__cache_open(const char *path, char *lpath, size_t size)
+{
+  char sumpath[4300], want[65], hex[65];
+  snprintf(sumpath, sizeof sumpath, "%s.sha256", path);
+  int sfd = open(sumpath, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (sfd < 0)
+    return -1;
+  struct stat st;
+  ssize_t k = -1;
+  if (fstat(sfd, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == getuid()
+      && (st.st_mode & 022) == 0)
+    k = read(sfd, want, 64);
+  close(sfd);
+  if (k != 64)
+    return -1;
+  want[64] = '\0';
+  int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0)
+    return -1;
+  size_t n;
+  char *data = NULL;
+  if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == getuid()
+      && (st.st_mode & 022) == 0)
+    data = read_fd(fd, &n);
+  if (data == NULL) {
+    close(fd);
+    return -1;
+  }
+  digest_hex(data, n, hex);
+  free(data);
+  if (strcmp(hex, want) != 0) {
+    close(fd);
+    return -1;
+  }
+  snprintf(lpath, size, "/proc/self/fd/%d", fd);
+  if (access(lpath, R_OK) != 0)
+    snprintf(lpath, size, "%s", path);
+  return fd;
 }
 
 /* Compile src into dir/f.so (files in dir, which the caller removes). */
