@@ -6,7 +6,9 @@
  */
 #include <config.h>
 
+#include <errno.h>
 #include <locale.h>
+#include <stdio_ext.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +19,7 @@
 #include <lua.h>
 #include <lualib.h>
 
+#include "core/cleanup.h"
 #include "core/interrupt.h"
 #include "lua/dmlua.h"
 #include "app/repl.h"
@@ -409,11 +412,38 @@ static int pmain(lua_State *L)
   return 1;
 }
 
+/* {======================================================================
+ * exit checks: output lost must not look like success
+ * ======================================================================= */
+
+/* At exit (also os.exit): if what was printed could not all be written
+ * (stdout closed, a full disk, `> /dev/full`), say so and exit 1, as
+ * coreutils' close_stdout does.  A closed stdout nobody wrote to is fine. */
+static void close_stdout(void)
+{
+  int pending = __fpending(stdout) != 0, failed = ferror(stdout) != 0;
+  int closefail = fclose(stdout) != 0, err = errno;
+  if (failed || (closefail && (pending || err != EBADF))) {
+    fprintf(stderr, "%s: write error on standard output%s%s\n", progname,
+            closefail ? ": " : "", closefail ? strerror(err) : "");
+    fflush(stderr);
+    _exit(EXIT_FAILURE);
+  }
+}
+
+/* }====================================================================== */
+
 int main(int argc, char **argv)
 {
   int status, result;
   lua_State *L;
   setlocale(LC_CTYPE, "");        /* Readline and UTF-8; numbers stay "C" */
+  atexit(close_stdout);
+  /* temporary directories and compiler process groups go with us */
+  dm_cleanup_catch_signals();
+  /* past RLIMIT_FSIZE a write fails with EFBIG (reported) instead of
+   * killing the process with SIGXFSZ (a half-written temporary left) */
+  signal(SIGXFSZ, SIG_IGN);
   if (argc > 1 && strcmp(argv[1], "test") == 0)
     return dm_testrun(argc, argv);  /* `dmech test`: the test runner */
   L = luaL_newstate();
