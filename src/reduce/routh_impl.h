@@ -181,6 +181,17 @@ int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0,
                       dm_integ_stats *st, dm_err *e);
 const dm_tableau *dm_rsprk_tableau(const dm_rsprk *P);
 
+/* The continuous Routh equations under a GSL explicit Runge-Kutta stepper
+ * (routh_ode.c): y = (x, s, theta); step from (x0, s0) gives (x1, s1) and
+ * the theta increment.  alloc sets *order; DM_EUNSUP for the implicit and
+ * multistep steppers and for constrained reductions. */
+typedef struct dm_rode dm_rode;
+int dm_rode_alloc(dm_routh *red, const char *stepper, dm_rode **out, int *order, dm_err *e);
+void dm_rode_free(dm_rode *O);
+void dm_rode_reset(dm_rode *O);
+int dm_rode_step(dm_rode *O, double h, const double *x0, const double *s0, double *x1, double *s1,
+                 double *dtheta, dm_err *e);
+
 /* Singular-inertia test shared by the reduced integrators: *ref is set from
  * x on the first call (ref <= 0); returns DM_ESINGULAR with a message when
  * lambda_min(I(x)) <= sing_tol * ref or I(x) is not finite.  work: at least

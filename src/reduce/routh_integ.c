@@ -17,8 +17,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { K_RSPRK, K_DR, K_CLASSICAL };
-static const char *const kind_names[] = {"rsprk", "dr", "classical"};
+enum { K_RSPRK, K_DR, K_CLASSICAL, K_ODE };
+static const char *const kind_names[] = {"rsprk", "dr", "classical", "ode"};
 
 typedef struct rinteg {
   int kind;
@@ -26,6 +26,7 @@ typedef struct rinteg {
   dm_rsprk *P;
   dm_routh_dr *dr;               /* DR method, or psi for classical */
   dm_integrator *inner;          /* classical */
+  dm_rode *ode;                  /* rk4, gsl:<stepper> */
   int have_theta;
   double theta[DM_ROUTH_RMAX], ctheta[DM_ROUTH_RMAX], dth[DM_ROUTH_RMAX];
   /* classical: last output in both momentum charts (exact continuation) */
@@ -35,7 +36,7 @@ typedef struct rinteg {
   double sing_ref;
 } rinteg;
 
-static const dm_integrator_type rsprk_type, dr_type, classical_type;
+static const dm_integrator_type rsprk_type, dr_type, classical_type, ode_type;
 
 static const char *const routh_options[] = {"stages", "h", "tol", "maxiter", "simplified", NULL};
 /* RSPRK and classical also take a user tableau (method prk) */
@@ -43,6 +44,8 @@ static const char *const tableau_options[] = {"stages", "h", "tol", "maxiter", "
                                               "tableau", NULL};
 static const char *const routh_kinds[] = {DM_ROUTH_KIND, NULL};
 static const char *const rsprk_names[] = {"gauss", "midpoint", "lobatto", "trapezoid", "prk", NULL};
+static const char *const ode_names[] = {"rk4", NULL};
+static const char *const ode_options[] = {"h", NULL};
 
 /* muA(x) with the tape of gyro_r at zero velocity */
 static int muA_at(rinteg *R, const double *x, double *a, dm_err *e)
@@ -88,6 +91,7 @@ static void rinteg_free(dm_integrator *I)
   dm_rsprk_free(R->P);
   dm_routh_dr_free(R->dr);
   dm_integrator_free(R->inner);
+  dm_rode_free(R->ode);
   free(R->x0c);
   free(R);
   I->state = NULL;
@@ -228,6 +232,25 @@ static int classical_alloc(dm_integrator *I, dm_err *e)
   return st;
 }
 
+/* "rk4" (= "gsl:rk4"), "gsl:<explicit stepper>": the continuous Routh
+ * equations, theta integrated along (routh_ode.c) */
+static int ode_alloc(dm_integrator *I, dm_err *e)
+{
+  const char *stepper = strcmp(I->name, "rk4") == 0 ? "rk4" : I->variant;
+  rinteg *R;
+  int st;
+  if ((st = rinteg_new(I, K_ODE, &R, e)) != DM_OK)
+    return st;
+  if (stepper[0] == '\0')
+    return dm_err_set(e, DM_EINVAL, "name the stepper: gsl:rk4, gsl:rk8pd, ...");
+  if ((st = dm_rode_alloc(R->red, stepper, &R->ode, &I->order, e)) != DM_OK)
+    return st;
+  /* mechanical: xdot = Mtilde^{-1} s, no nonlinear solve */
+  I->flags = DM_INTEG_FORCES | (R->red->general ? 0u : (unsigned)DM_INTEG_EXPLICIT);
+  R->have_theta = 1;
+  return DM_OK;
+}
+
 static void add_theta(rinteg *R)
 {
   size_t a;
@@ -278,6 +301,19 @@ static void zero_dtheta(rinteg *R)
   size_t a;
   for (a = 0; a < R->red->r; a++)
     R->dth[a] = 0.0;
+}
+
+static int ode_step(dm_integrator *I, double h, const double *q0, const double *p0, double *q1,
+                    double *p1, dm_err *e)
+{
+  rinteg *R = I->state;
+  int st;
+  zero_dtheta(R);
+  if ((st = dm_rode_step(R->ode, h, q0, p0, q1, p1, R->dth, e)) == DM_OK) {
+    I->stats.steps++;
+    add_theta(R);
+  }
+  return st;
 }
 
 static int classical_type_step(dm_integrator *I, double h, const double *q0, const double *p0,
@@ -413,6 +449,8 @@ static void routh_reset(dm_integrator *I)
     dm_integrator_reset(R->inner);
   R->last_valid = 0;
   R->sing_ref = 0.0;
+  if (R->ode)
+    dm_rode_reset(R->ode);
 }
 
 static const dm_integrator_type rsprk_type = {
@@ -462,14 +500,29 @@ static const dm_integrator_type classical_type = {
   .kinds = routh_kinds,
 };
 
+static const dm_integrator_type ode_type = {
+  .name = "gsl",
+  .summary = "the continuous Routh equations (non-symplectic references) of a Routh reduction: "
+    "rk4 (= gsl:rk4), gsl:<rk2|rkf45|rkck|rk8pd>; theta integrated along",
+  .order = 0,
+  .flags = DM_INTEG_FORCES,
+  .options = ode_options,
+  .alloc = ode_alloc,
+  .step = ode_step,
+  .reset = routh_reset,
+  .free = rinteg_free,
+  .kinds = routh_kinds,
+  .names = ode_names,
+};
+
 /* {==== public helpers =================================================== */
 
 int dm_routh_register_integrators(dm_err *e)
 {
-  const dm_integrator_type *const types[] = {&rsprk_type, &dr_type, &classical_type};
+  const dm_integrator_type *const types[] = {&rsprk_type, &dr_type, &classical_type, &ode_type};
   size_t i;
   int st = DM_OK;
-  for (i = 0; i < 3 && st == DM_OK; i++)
+  for (i = 0; i < 4 && st == DM_OK; i++)
     st = dm_integrator_register(types[i], e);
   return st;
 }
@@ -489,7 +542,8 @@ int dm_routh_integrator_new(dm_routh *red, const char *method, const dm_integ_op
 int dm_routh_is_integrator(const dm_integrator *I)
 {
   return I != NULL && I->state != NULL
-         && (I->type == &rsprk_type || I->type == &dr_type || I->type == &classical_type);
+         && (I->type == &rsprk_type || I->type == &dr_type || I->type == &classical_type
+             || I->type == &ode_type);
 }
 
 int dm_routh_integrator_theta(const dm_integrator *I, double *theta, dm_err *e)

@@ -74,6 +74,18 @@ do   -- discrete Routh equations with the Galerkin L_d of the full system
   T.ok(def <= 1e-13, ("symplecticity defect of the reduced step in (r, p_r) (%.2g)"):format(def))
 end
 
+do   -- the Routh equations under rk4 = the unreduced rk4 run (p_theta stays mu)
+  local rt = dm.integrator(red, {method = "rk4", h = h}):run(st, {steps = 300, every = 100})
+  local ut = dm.integrator(sys, {method = "rk4", h = h}):run({q = q0, v = v0}, {steps = 300, every = 100})
+  local full = red:reconstruct(rt, {theta = th0})
+  local d = 0
+  for i = 1, #rt do
+    d = math.max(d, math.abs(rt:column("r")[i] - ut:column("r")[i]), math.abs(rt:column("p_r")[i] - ut:column("p_r")[i]),
+                 math.abs(full:column("theta")[i] - ut:column("theta")[i]))
+  end
+  T.ok(d <= 1e-11, ("rk4 on the numerical Routhian = unreduced rk4, theta included (%.2g)"):format(d))
+end
+
 -- what a non-mechanical reduction does not have
 T.error_like(function() return red.A end, "red.A: 'relativistic particle' is not mechanical", "no connection")
 T.error_like(function() return red.amended end, "no locked inertia, connection or amended potential", "no amended potential")

@@ -148,7 +148,8 @@ T.ok(R2.family == "rsprk" and maxdiff(R2:run(st, {steps = 200, every = 10}), tr,
 local ms, mr = dm.methods(), dm.methods(rd)
 T.ok(ms.gauss and ms.rk4 and not ms.routh and not ms.rsprk and not ms.dr and not ms.classical,
      "dm.methods() lists the Lagrangian methods only (no routh, rsprk, dr, classical)")
-T.ok(mr.gauss and mr.gauss:find("RSPRK") and mr.dr and mr.classical and mr.rsprk and not mr.rk4
+T.ok(mr.gauss and mr.gauss:find("RSPRK") and mr.dr and mr.classical and mr.rsprk and not mr.composition
+     and mr.rk4 and mr.rk4:find("continuous Routh equations", 1, true)
      and dm.methods("routh").dr == mr.dr and dm.methods(rd.system).classical == mr.classical,
      "dm.methods(red | red.system | \"routh\") lists the reduced families")
 
@@ -215,6 +216,34 @@ do
     "reduced prk without a tableau")
   T.error_like(function() dm.integrator(rd, {method = "gauss", tableau = g3, h = 0.02}) end,
     "option 'tableau' is for method 'prk' %(got method 'gauss'%)", "a tableau with another method is an error, not ignored")
+end
+
+-- the continuous Routh equations as references: rk4 and gsl:<stepper> on the
+-- reduced system (theta integrated along) --------------------------------------
+do
+  local st4, mu4, th4 = rd:project{q = q0, v = v0}
+  local T4 = 2
+  local ref = dm.integrator(dsp, {method = "gauss", stages = 6, h = 0.0025}):run({q = q0, v = v0}, {t = T4})
+  local rr, rth = ref:column("r1")[#ref], ref:column("theta")[#ref]
+  local hs, er, et = {0.02, 0.01, 0.005}, {}, {}
+  for k, h in ipairs(hs) do
+    local tr4 = dm.integrator(rd, {method = "rk4", h = h}):run(st4, {t = T4})
+    local f4 = rd:reconstruct(tr4, {theta = th4})
+    er[k] = math.abs(tr4:column("r1")[#tr4] - rr)
+    et[k] = math.abs(f4:column("theta")[#f4] - rth)
+  end
+  local pr, pt = math.log(er[1] / er[3], 4), math.log(et[1] / et[3], 4)
+  T.ok(math.abs(pr - 4) <= 0.15 and math.abs(pt - 4) <= 0.15,
+       ("rk4 on the reduced system: order %.2f in r1, %.2f in the reconstructed theta"):format(pr, pt))
+  local t8 = dm.integrator(rd, {method = "gsl:rk8pd", h = 0.02}):run(st4, {t = T4})
+  local f8 = rd:reconstruct(t8, {theta = th4})
+  local d8 = math.max(math.abs(t8:column("r1")[#t8] - rr), math.abs(f8:column("theta")[#f8] - rth))
+  T.ok(d8 <= 1e-12, ("gsl:rk8pd on the Routh equations = unreduced Gauss 6 (%.2g)"):format(d8))
+  T.ok(not dm.integrator(rd, {method = "rk4", h = 0.01}).symplectic, "rk4 on the reduced system is not symplectic")
+  T.error_like(function() dm.integrator(rd, {method = "gsl:bsimp", h = 0.01}) end,
+    "gsl:bsimp on a reduced system: implicit and multistep steppers need the Jacobian", "implicit GSL steppers refused with the reason")
+  T.error_like(function() dm.integrator(rd, {method = "gsl:nosuch", h = 0.01}) end,
+    "unknown GSL stepper 'nosuch' for a reduced system", "unknown stepper")
 end
 
 -- structure --------------------------------------------------------------------
@@ -329,12 +358,12 @@ T.error_like(function() dm.routh(sat, {}) end, "cyclic", "cyclic coordinates req
 T.error_like(function() dm.routh(dm.builtin.kepler{}, {cyclic = {"x"}}) end, "Lagrangian", "built-in C systems have no expressions")
 do
   local line = debug.getinfo(1, "l").currentline + 1
-  local ok, msg = pcall(function() return dm.integrator(red, {method = "rk4"}) end)
-  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. line .. ": dm%.integrator: method 'rk4' does not apply to system '[^']*' %(a routh system%); it integrates lagrangian systems %(methods here: rsprk, gauss, midpoint, lobatto, trapezoid, prk, dr, classical%)$"),
+  local ok, msg = pcall(function() return dm.integrator(red, {method = "composition"}) end)
+  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. line .. ": dm%.integrator: method 'composition' does not apply to system '[^']*' %(a routh system%); it integrates lagrangian systems %(methods here: rsprk, gauss, midpoint, lobatto, trapezoid, prk, dr, classical, gsl:<stepper>, rk4%)$"),
        "non-reduced methods are refused on a reduction, at the user's line: " .. tostring(msg))
-  ok, msg = pcall(function() return dm.integrator(red.system, {method = "rk4"}) end)
-  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. (line + 3) .. ": dm%.integrator: method 'rk4' does not apply"),
-       "and on its reduced system (the magnetic term would be lost): " .. tostring(msg))
+  ok, msg = pcall(function() return dm.integrator(red.system, {method = "composition"}) end)
+  T.ok(not ok and msg:find("^[^:]*reduce_routh%.lua:" .. (line + 3) .. ": dm%.integrator: method 'composition' does not apply"),
+       "and on its reduced system: " .. tostring(msg))
   ok, msg = pcall(function() return dm.integrator(sat, {method = "dr"}) end)
   T.ok(not ok and msg:find("dm.integrator: method 'dr' does not apply to system '[^']*' %(a lagrangian system%); it integrates routh systems"),
        "a reduced method on an unreduced system says what it integrates: " .. tostring(msg))
