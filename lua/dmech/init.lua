@@ -25,4 +25,10 @@ dm.doc("dm.pretty", "dm.pretty(x[, depth]) -> string",
 
 dm.test = require "dmech.test"
 
+-- pictures of meshes and cochains (lua/dmech/meshplot.lua), loaded on first use
+function dm.plot_mesh(spec) return require("dmech.meshplot").plot(spec) end
+dm.doc("dm.plot_mesh", "dm.plot_mesh{M, values = c, arrows = a | mat, output = \"f.png\", ...}",
+       "Draw a triangle mesh with a 0-cochain as coloured triangles (pm3d) and 1-cochains or vectors as arrows.",
+       dm.plot_mesh)
+
 return dm

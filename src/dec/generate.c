@@ -208,7 +208,7 @@ dm_dec_meshdata *dm_dec_gen_disc(double r, int nr, dm_err *e)
   m->X[0] = m->X[1] = 0.0;
   for (i = 1; i <= nr; i++)
     for (j = 0; j < 6 * i; j++, v++) {
-      double rho = i == nr ? r : r * i / nr, th = 2 * M_PI * j / (6 * i);
+      double rho = i == nr ? r : r * i / nr, th = 2 * M_PI * (j + 0.5 * (i % 2)) / (6 * i);
       m->X[2 * v] = rho * cos(th);
       m->X[2 * v + 1] = rho * sin(th);
     }
@@ -219,7 +219,7 @@ dm_dec_meshdata *dm_dec_gen_disc(double r, int nr, dm_err *e)
   }
   for (i = 2, v = 1; i <= nr; i++) {
     int a = 6 * (i - 1);
-    t += zipper(m->T + 3 * t, v, a, 0, v + a, 6 * i, 0);
+    t += zipper(m->T + 3 * t, v, a, 0.5 * ((i - 1) % 2), v + a, 6 * i, 0.5 * (i % 2));
     v += a;
   }
   orient_ccw(m);

@@ -615,9 +615,10 @@ static int m_cochain(lua_State *L)
 
 static int m_laplacian(lua_State *L)
 {
-  static const char *const known[] = {"boundary", "value", NULL};
+  static const char *const known[] = {"boundary", "value", "pin", NULL};
   dm_lmesh *M = dm_checkmesh(L, 1);
   int k = checkdeg(L, 2, M, 0, M->K->n), n = M->K->n, i, dirichlet = 0, st;
+  lua_Integer pin = 0;
   dm_sparse *Delta = NULL, *S = NULL;
   dm_lsparse *s;
   dm_err e;
@@ -631,6 +632,10 @@ static int m_laplacian(lua_State *L)
       dirichlet = 1;
     else if (strcmp(bc, "none") != 0)
       return luaL_error(L, "mesh:laplacian: boundary must be \"dirichlet\" or \"none\", got \"%s\"", bc);
+    pin = dm_optintegerfield(L, 3, "pin", 0);
+    if (pin != 0 && (dirichlet || pin < 1 || pin > M->K->nsimp[k]))
+      return luaL_error(L, "mesh:laplacian: pin must be a %d-simplex index in 1..%d (without boundary = \"dirichlet\")",
+                        k, M->K->nsimp[k]);
   }
   warn_star(M, k);
   if (k > 0)
@@ -649,7 +654,18 @@ static int m_laplacian(lua_State *L)
   if (s->w == NULL)
     return luaL_error(L, "mesh:laplacian: out of memory");
   dm_dec_star(M->G, k, 0, s->w, NULL);
-  s->kernel = !dirichlet;
+  s->kernel = !dirichlet && pin == 0;
+  if (pin != 0) {            /* one unknown held at 0: fixes the constants of a closed mesh */
+    s->fixed = calloc((size_t)M->K->nsimp[k] + 1, 1);
+    s->g = calloc((size_t)M->K->nsimp[k] + 1, sizeof *s->g);
+    if (s->fixed == NULL || s->g == NULL)
+      return luaL_error(L, "mesh:laplacian: out of memory");
+    s->fixed[pin - 1] = 1;
+    if ((Delta = dm_sparse_fix_rows(s->A, s->fixed, &e)) == NULL)
+      return dm_lua_fail(L, "mesh:laplacian", e.status, &e);
+    dm_sparse_free(s->A);
+    s->A = Delta;
+  }
   if (dirichlet) {
     int nb = 0;
     s->fixed = malloc((size_t)M->K->nsimp[k] + 1);
@@ -803,8 +819,8 @@ static const dm_reg mesh_methods[] = {
   {"star", m_star, "M:star(k[, {dual = true}]) -> sparse",
    "The Hodge star from primal k-cochains to dual (n-k)-cochains (with dual = true: from dual k- to primal (n-k)-cochains)."},
   {"codiff", m_codiff, "M:codiff(k) -> sparse", "The codifferential from primal k- to (k-1)-cochains, the adjoint of d(k-1)."},
-  {"laplacian", m_laplacian, "M:laplacian(k[, {boundary = \"dirichlet\", value = g}]) -> sparse",
-   "The Laplace-de Rham operator d delta + delta d on primal k-cochains (positive semidefinite); Dirichlet rows fix the boundary values to g (default 0)."},
+  {"laplacian", m_laplacian, "M:laplacian(k[, {boundary = \"dirichlet\", value = g} | {pin = i}]) -> sparse",
+   "The Laplace-de Rham operator d delta + delta d on primal k-cochains (positive semidefinite); Dirichlet rows fix the boundary values to g (default 0), pin = i holds simplex i at 0 (closed meshes)."},
   {"cochain", m_cochain, "M:cochain(k, f | values | number[, {dual = true}]) -> cochain",
    "A k-cochain: integrals of a form given by f(x, y[, z]) over the k-simplices (values for k = 0, 1-form components for k = 1, a density for k = n), or given values."},
   {"vertices", m_vertices, "M:vertices() -> {{x, y, ...}, ...}", "The vertex coordinates."},

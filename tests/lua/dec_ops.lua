@@ -96,4 +96,21 @@ local u, cycles = F:mg_solve(F:cochain(0, 4))
 local ref = F:laplacian(0, {boundary = "dirichlet"}):solve(F:cochain(0, 4))
 T.ok((u - ref):norm(math.huge) < 1e-9 and cycles < 15, "multigrid = CHOLMOD in " .. cycles .. " V-cycles")
 T.error_like(function() return D:mg_solve(D:cochain(0, 1)) end, "was not made by mesh:refine", "multigrid needs a refinement chain")
+
+-- pictures: dm.plot_mesh writes a PNG (gnuplot needed)
+if os.execute("command -v gnuplot > /dev/null 2>&1") then
+  local png = tmp .. "/mesh.png"
+  dm.plot_mesh{D, values = f0, arrows = D:d(0) * f0, output = png}
+  local fh = io.open(png, "rb")
+  T.ok(fh ~= nil and #fh:read("a") > 1000, "plot_mesh writes a PNG")
+  if fh then fh:close() end
+  dm.plot_mesh{S, values = S:cochain(0, function(x, y, z) return z end), output = tmp .. "/sphere.png"}
+  T.ok(io.open(tmp .. "/sphere.png") ~= nil, "plot_mesh of a surface in R^3")
+else
+  T.skip("gnuplot not installed")
+  T.skip("gnuplot not installed")
+end
+T.error_like(function() dm.plot_mesh{D, colour = 1} end, "dm.plot_mesh: unknown option 'colour'", "plot_mesh option check")
+T.error_like(function() dm.plot_mesh{B, values = B:cochain(0, 1)} end, "triangle meshes in R%^2 or R%^3 only", "plot_mesh refuses tetrahedra")
+T.error_like(function() dm.plot_mesh{D, values = S:cochain(0, 1)} end, "the cochain lives on another mesh", "plot_mesh: cochain of another mesh")
 T.done()
