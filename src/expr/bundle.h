@@ -138,7 +138,7 @@ static inline int dm_bundle_run(const dm_bundle *p, const double *const *in, siz
                                 double *work)
 {
   if (p->scatter != NULL)
-    return p->scatter(in, par, out, mask);
+    return p->scatter(in, par, out, mask, work);
   for (size_t k = 0, a = 0; k < p->nin; k += inlen, a++)
     for (size_t i = 0; i < inlen; i++)
       work[k + i] = in[a][i];

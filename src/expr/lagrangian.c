@@ -79,7 +79,7 @@ static int lag_run(const lag_data *d, const double *q, const double *v,
   double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    return p->scatter(in, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill);
+    return p->scatter(in, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill, w);
   }
   copy(w, q, n);
   if (p->nin > n)
@@ -138,7 +138,7 @@ static int force_run(const lag_data *d, const double *q, const double *v,
   what &= DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V;
   if (p->scatter != NULL) {
     const double *in[2] = { q, v };
-    return p->scatter(in, par, o, what);
+    return p->scatter(in, par, o, what, w);
   }
   copy(w, q, n);
   copy(w + n, v, n);
@@ -182,7 +182,7 @@ static int constr_eval(void *data, const double *q, const double *par,
   double *o[3] = { g, G, H };
   if (p->scatter != NULL) {
     const double *in[1] = { q };
-    return p->scatter(in, par, o, what);
+    return p->scatter(in, par, o, what, work);
   }
   double *w = work;
   copy(w, q, d->n);
@@ -802,14 +802,14 @@ int dm_lagrangian_stats_get(const dm_system *sys, dm_lagrangian_stats *st)
   st->ninstr_grad = dm_tape_ninstr(d->grad.tape);
   st->ninstr_all = dm_tape_ninstr(d->all.tape);
   st->nregs_all = dm_tape_nregs(d->all.tape);
-  st->native_grad = d->grad.fn != NULL;
-  st->native_all = d->all.fn != NULL;
+  st->native_grad = d->grad.nat != NULL;
+  st->native_all = d->all.nat != NULL;
   st->ninstr_force = d->force_all.tape ? dm_tape_ninstr(d->force_all.tape) : 0;
   st->ninstr_constr = d->constr_all.tape ? dm_tape_ninstr(d->constr_all.tape) : 0;
   st->ninstr_q = d->lq.tape ? dm_tape_ninstr(d->lq.tape) : 0;
   st->ninstr_sep = d->qvqq.tape ? dm_tape_ninstr(d->qvqq.tape) : 0;
-  st->native_q = d->lq.fn != NULL;
-  st->native_sep = d->qvqq.fn != NULL;
+  st->native_q = d->lq.nat != NULL;
+  st->native_sep = d->qvqq.nat != NULL;
   st->sparse = d->sparse;
   return DM_OK;
 }

@@ -6,6 +6,25 @@
 #include "expr/native.h"
 
 #define CC_FLAGS "-O1 -fPIC -shared -ffp-contract=off -fno-math-errno"
+/* Units compiled separately (with an optimisation level chosen by size),
+ * then linked. */
+#define CC_UNIT_FLAGS "-c -fPIC -ffp-contract=off -fno-math-errno"
+#define CC_LINK_FLAGS "-shared"
+
+/* The source of a tape as translation units (native_emit.c); the last one
+ * holds the entry point.  nslot: doubles the entry point keeps on its
+ * stack for values passed between chunks. */
+typedef struct dm_native_srcs {
+  size_t n;
+  char **src;
+  size_t nslot;
+} dm_native_srcs;
+/* Chunks of at most `chunk` instructions, `per_unit` chunks per unit;
+ * inmap / outmap NULL: the flat dm_native_eval, else dm_native_scatter. */
+int dm_native__emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
+                    const dm_native_map *outmap, size_t chunk, size_t per_unit,
+                    dm_native_srcs *out);
+void dm_native__srcs_free(dm_native_srcs *s);
 
 /* Split a compiler command at blanks into argv[0..k) (copy is modified). */
 int dm_native__cc_words(char *copy, char **argv, int max);
@@ -28,5 +47,18 @@ int dm_native__build(char **ccargv, int ncc, const char *dir, const char *src,
                      char *obj, size_t objsize, dm_err *err);
 /* Remove dir/f.c, dir/f.so and dir. */
 void dm_native__remove_tree(const char *dir);
+/* Write src[k] to dir/u<k>.c, compile each to u<k>.o with CC_UNIT_FLAGS
+ * and opt (at most par compilers at once), link them into dir/f.so (path
+ * into obj).  The first failure wins; compilers still running are
+ * stopped. */
+int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const *src,
+                           size_t n, const char *opt, int par, char *obj,
+                           size_t objsize, dm_err *err);
+/* Remove the files of dm_native__build_units and dir. */
+void dm_native__remove_units(const char *dir, size_t n);
+/* The compilations started by this thread stop when *flag becomes
+ * non-zero (background jobs) instead of at dm_interrupted() (NULL, the
+ * default: the foreground). */
+void dm_native__set_cancel(const volatile int *flag);
 
 #endif

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <pthread.h>
 #include <spawn.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -23,6 +24,23 @@
 extern char **environ;
 
 #define CC_TIMEOUT 300.0      /* seconds, unless $DMECH_CC_TIMEOUT says */
+
+/* What stops this thread's compilations: the interrupt flag (foreground)
+ * or a job's cancel flag (background threads must not die of a Ctrl-C
+ * meant for the computation in the foreground). */
+static _Thread_local const volatile int *tl_cancel, *tl_stop;
+
+void dm_native__set_cancel(const volatile int *flag)
+{
+  tl_cancel = flag;
+}
+
+/* tl_stop: a failure in a sibling compilation (dm_native__build_units) */
+static int cancelled(void)
+{
+  return (tl_cancel != NULL ? *tl_cancel != 0 : dm_interrupted()) ||
+         (tl_stop != NULL && *tl_stop != 0);
+}
 
 
 /* {==================================================================
@@ -213,8 +231,8 @@ static int run(char *const argv[], char *out, size_t size, int *status,
     pid_t w = waitpid(pid, &ws, WNOHANG);
     if (w == pid)
       break;
-    if (dm_interrupted() || now() - t0 > limit) {
-      result = dm_interrupted() ? DM_EINTR : DM_ETIMEOUT;
+    if (cancelled() || now() - t0 > limit) {
+      result = cancelled() ? DM_EINTR : DM_ETIMEOUT;
       kill(-pid, SIGKILL);
       while (waitpid(pid, &ws, 0) < 0 && errno == EINTR)
         ;
@@ -505,6 +523,160 @@ void dm_native__remove_tree(const char *dir)
     snprintf(p, sizeof p, "%s/%s", dir, files[i]);
     unlink(p);
   }
+  rmdir(dir);
+}
+
+/* {==================================================================
+ * units compiled in parallel
+ * =================================================================== */
+
+typedef struct unit_job {
+  char **ccargv;
+  int ncc;
+  const char *dir, *opt;
+  char *const *src;
+  size_t n, next;           /* units; the next one to take */
+  pthread_mutex_t mu;
+  const volatile int *cancel;   /* the starting thread's */
+  volatile int stop;        /* set by the first failure */
+  int status;
+  dm_err err;
+} unit_job;
+
+/* Compile unit k: write it, run the compiler. */
+static int compile_unit(unit_job *J, size_t k, dm_err *err)
+{
+  char cpath[4200], opath[4200], flags[] = CC_UNIT_FLAGS, opt[64], *argv[64], msg[2048];
+  int a = 0, status;
+  snprintf(cpath, sizeof cpath, "%s/u%zu.c", J->dir, k);
+  snprintf(opath, sizeof opath, "%s/u%zu.o", J->dir, k);
+  if (write_file(cpath, J->src[k], strlen(J->src[k])) != 0)
+    return dm_err_set(err, DM_EIO, "native: cannot write %s: %s", cpath, strerror(errno));
+  for (int i = 0; i < J->ncc && a < 40; i++)
+    argv[a++] = J->ccargv[i];
+  a += dm_native__cc_words(flags, argv + a, 16);
+  snprintf(opt, sizeof opt, "%s", J->opt);
+  a += dm_native__cc_words(opt, argv + a, 4);
+  argv[a++] = "-o";
+  argv[a++] = opath;
+  argv[a++] = cpath;
+  argv[a] = NULL;
+  int s = run(argv, msg, sizeof msg, &status, err);
+  if (s != DM_OK)
+    return s;
+  if (status != 0)
+    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s", J->ccargv[0],
+                      status, msg);
+  return DM_OK;
+}
+
+/* A worker: units until none is left or one failed; it stops with the
+ * caller's stop condition too. */
+static void *unit_worker(void *arg)
+{
+  unit_job *J = arg;
+  const volatile int *save = tl_cancel, *save2 = tl_stop;
+  tl_cancel = J->cancel;
+  tl_stop = &J->stop;
+  for (;;) {
+    pthread_mutex_lock(&J->mu);
+    size_t k = J->next < J->n && !J->stop ? J->next++ : J->n;
+    pthread_mutex_unlock(&J->mu);
+    if (k >= J->n)
+      break;
+    dm_err e;
+    int s = compile_unit(J, k, &e);
+    pthread_mutex_lock(&J->mu);
+    if (s != DM_OK && J->status == DM_OK) {
+      J->status = s;
+      J->err = e;
+      J->stop = 1;
+    }
+    pthread_mutex_unlock(&J->mu);
+  }
+  tl_cancel = save;
+  tl_stop = save2;
+  return NULL;
+}
+
+int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const *src,
+                           size_t n, const char *opt, int par, char *obj,
+                           size_t objsize, dm_err *err)
+{
+  unit_job J;
+  memset(&J, 0, sizeof J);
+  J.ccargv = ccargv;
+  J.ncc = ncc;
+  J.dir = dir;
+  J.opt = opt;
+  J.src = src;
+  J.n = n;
+  J.cancel = tl_cancel;
+  pthread_mutex_init(&J.mu, NULL);
+  enum { MAXPAR = 8 };
+  pthread_t th[MAXPAR];
+  int nth = par < 1 ? 1 : par > MAXPAR ? MAXPAR : par, started = 0;
+  if ((size_t)nth > n)
+    nth = (int)n;
+  for (int i = 1; i < nth; i++)           /* this thread is worker 0 */
+    if (pthread_create(&th[i], NULL, unit_worker, &J) == 0)
+      started |= 1 << i;
+  unit_worker(&J);
+  for (int i = 1; i < nth; i++)
+    if (started & (1 << i))
+      pthread_join(th[i], NULL);
+  pthread_mutex_destroy(&J.mu);
+  if (J.status != DM_OK) {
+    if (err != NULL)
+      *err = J.err;
+    return J.status;
+  }
+  if (cancelled())
+    return dm_err_set(err, DM_EINTR, "native: compilation interrupted");
+  /* link */
+  char flags[] = CC_LINK_FLAGS, msg[2048];
+  char (*opath)[4200] = malloc(n * sizeof *opath);
+  char **largv = malloc((n + 64) * sizeof *largv);
+  if (opath == NULL || largv == NULL) {
+    free(opath);
+    free(largv);
+    return dm_err_set(err, DM_ENOMEM, "native: out of memory");
+  }
+  int a = 0, status;
+  for (int i = 0; i < ncc && a < 40; i++)
+    largv[a++] = ccargv[i];
+  a += dm_native__cc_words(flags, largv + a, 8);
+  snprintf(obj, objsize, "%s/f.so", dir);
+  largv[a++] = "-o";
+  largv[a++] = obj;
+  for (size_t k = 0; k < n; k++) {
+    snprintf(opath[k], sizeof opath[k], "%s/u%zu.o", dir, k);
+    largv[a++] = opath[k];
+  }
+  largv[a++] = "-lm";
+  largv[a] = NULL;
+  int s = run(largv, msg, sizeof msg, &status, err);
+  free(opath);
+  free(largv);
+  if (s != DM_OK)
+    return s;
+  if (status != 0)
+    return dm_err_set(err, DM_EFAILED, "native: linking with %s failed (exit %d): %s",
+                      ccargv[0], status, msg);
+  return DM_OK;
+}
+
+void dm_native__remove_units(const char *dir, size_t n)
+{
+  char p[4200];
+  for (size_t k = 0; k < n; k++) {
+    snprintf(p, sizeof p, "%s/u%zu.c", dir, k);
+    unlink(p);
+    snprintf(p, sizeof p, "%s/u%zu.o", dir, k);
+    unlink(p);
+  }
+  snprintf(p, sizeof p, "%s/f.so", dir);
+  unlink(p);
   rmdir(dir);
 }
 

@@ -105,6 +105,80 @@ static void test_agreement(void)
   dm_tape_free(t);
 }
 
+/* A tape long enough to be cut into chunks and units: a recurrence whose
+ * values cross chunks (s_k needs s_{k-1}, sincos pairs, a square root that
+ * is NaN for y > 1.2), its outputs scattered into three arrays; flat and
+ * scattered code against the tape, a partial mask, the NaN report. */
+static void test_chunks(void)
+{
+  enum { K = 600 };
+  dm_expr out[2 * K], s = dm_expr_const(C, 0.0), x = V[0], y = V[1];
+  dm_expr r = dm_expr_unary(C, DM_EXPR_SQRT, dm_expr_sub(C, dm_expr_const(C, 1.2), y));
+  for (int k = 0; k < K; k++) {
+    dm_expr a = dm_expr_mul(C, x, dm_expr_const(C, 0.01 * (k + 1)));
+    dm_expr u = dm_expr_mul(C, dm_expr_unary(C, DM_EXPR_SIN, a), dm_expr_unary(C, DM_EXPR_COS, a));
+    s = dm_expr_add(C, dm_expr_mul(C, s, dm_expr_const(C, 0.999)),
+                    dm_expr_mul(C, u, k % 7 ? y : r));
+    out[k] = s;
+    out[K + k] = dm_expr_div(C, dm_expr_mul(C, s, V[3]), dm_expr_add(C, dm_expr_powi(C, a, 2),
+                                                                     dm_expr_const(C, 1.0)));
+  }
+  dm_tape *t;
+  int st = dm_tape_compile_exact(C, 2 * K, out, 3, V, 2, V + 3, &t, NULL);
+  size_t ni = st == DM_OK ? dm_tape_ninstr(t) : 0;
+  char *src = st == DM_OK ? dm_native_source(t) : NULL;
+  tap_ok(src && ni > 4000 && strstr(src, "/* unit 2 */") && strstr(src, "dm_k8(") &&
+         strstr(src, "r[") != NULL, "a tape of %zu instructions: several units, chunks and "
+         "values passed between them", ni);
+  free(src);
+  if (st != DM_OK)
+    return;
+  dm_native *nat;
+  dm_err err;
+  st = dm_native_compile(t, base, base + 3, &nat, &err);
+  tap_ok(st == DM_OK && mismatches(t, dm_native_function(nat), base, 50, 0.2) == 0,
+         "chunked flat code = tape on 50 points%s%s", st ? ": " : "", st ? err.msg : "");
+  dm_native_free(nat);
+  /* mapped: s_k to a[k] and b[K-1-k], the quotients to c[k] */
+  dm_native_map im[3] = { { 0, 0, 0 }, { 1, 0, 1 }, { 2, 0, 2 } }, om[3 * K];
+  for (uint32_t k = 0; k < K; k++) {
+    om[3 * k] = (dm_native_map){ k, 0, k };
+    om[3 * k + 1] = (dm_native_map){ k, 1, K - 1 - k };
+    om[3 * k + 2] = (dm_native_map){ K + k, 2, k };
+  }
+  st = dm_native_compile_mapped(t, base, base + 3, im, 3 * K, om, &nat, &err);
+  tap_ok(st == DM_OK && dm_native_function(nat) == NULL && dm_native_scatter(nat) != NULL,
+         "chunked scatter code compiled (no flat function)%s%s", st ? ": " : "",
+         st ? err.msg : "");
+  if (st != DM_OK) {
+    dm_tape_free(t);
+    return;
+  }
+  static double a[K], b[K], c[K], o[2 * K], work[8 * K];
+  double *w = malloc(dm_tape_work_size(t) * sizeof *w);
+  double in[3] = { 0.7, 0.9, 1.1 }, par[2] = { 1.385, 0.7125 };
+  const double *ins[1] = { in };
+  double *outs[3] = { a, b, c };
+  dm_tape_eval(t, in, par, o, w);
+  int rc = dm_native_scatter(nat)(ins, par, outs, 7u, work), same = rc == 0;
+  for (int k = 0; k < K; k++)
+    same &= agree(a[k], o[k]) && b[K - 1 - k] == a[k] && agree(c[k], o[K + k]);
+  tap_ok(same, "scatter: every destination = tape");
+  for (int k = 0; k < K; k++)
+    b[k] = -1.0;
+  rc = dm_native_scatter(nat)(ins, par, outs, 5u, work);
+  same = rc == 0;
+  for (int k = 0; k < K; k++)
+    same &= b[k] == -1.0 && agree(a[k], o[k]) && agree(c[k], o[K + k]);
+  tap_ok(same, "scatter with array 1 left out of the mask: untouched, the others written");
+  in[1] = 1.5;                          /* sqrt(1.2 - y): NaN */
+  rc = dm_native_scatter(nat)(ins, par, outs, 7u, work);
+  tap_is_int(rc, 1, "an output NaN: the scatter reports 1");
+  free(w);
+  dm_native_free(nat);
+  dm_tape_free(t);
+}
+
 /* The object cache, on a small tape (quick to compile). */
 static void test_cache(void)
 {
@@ -284,6 +358,7 @@ int main(void)
     return 0;
   }
   test_agreement();
+  test_chunks();
   test_cache();
   test_dsp();
   test_failures();
