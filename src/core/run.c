@@ -258,7 +258,7 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
   run r;
   double start, piece_start;
   long P;
-  int st;
+  int st, bg;
   dm_err_clear(e);
   if (isfinite(o.t_end) && o.nsteps < 0 && isfinite(o.h) && o.h != 0.0
       && (st = dm_run_steps_to(o.t0, o.t_end, o.h, &o.nsteps, e)) != DM_OK)
@@ -286,12 +286,27 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
     goto done;
   }
   start = now();
-  P = o.piece > 0 ? o.piece : o.progress != NULL ? (o.every < 64 ? 64 : o.every) : o.nsteps;
+  /* code compiled in the background is installed between pieces, which
+   * are then ~0.1 s long even without a progress callback */
+  bg = I->sys->update != NULL && I->sys->update(I->sys);
+  P = o.piece > 0 ? o.piece
+      : o.progress != NULL || bg ? (o.every < 64 ? 64 : o.every) : o.nsteps;
   while (r.k < o.nsteps) {
     long end = o.nsteps - r.k > P ? r.k + P : o.nsteps;
     piece_start = now();
     if ((st = advance_to(&r, end, e)) != DM_OK)
       break;
+    if (bg) {
+      bg = I->sys->update(I->sys);
+      if (o.piece == 0 && o.progress == NULL) {
+        double dt = now() - piece_start;
+        P = dt > 1e-3 ? (long)((double)P * fmin(16.0, fmax(0.5, 0.1 / dt))) : 16 * P;
+        if (P < 1)
+          P = 1;
+        if (!bg)
+          P = o.nsteps;            /* nothing more to come: the rest at once */
+      }
+    }
     if (o.progress != NULL) {
       dm_run_progress pr;
       double tn = now(), dt = tn - piece_start;

@@ -123,6 +123,12 @@ typedef struct dm_system {
   size_t work_size;             /* bytes of scratch per concurrent caller */
 
   void (*free_data)(struct dm_system *);  /* releases what the filler owns */
+  /* Optional (NULL: nothing ever changes): install what has become ready
+   * since the last call -- native code compiled in the background while
+   * the tape ran; the results are the same to round-off either way.
+   * Drivers call it between steps, never during one, from the thread that
+   * uses the system.  Returns 1 while more is on its way, else 0. */
+  int (*update)(const struct dm_system *);
 } dm_system;
 
 /* Release what the system's filler owns (calls free_data) and zero *s.

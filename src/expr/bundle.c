@@ -6,6 +6,7 @@
 
 void dm_bundle_free(dm_bundle *p)
 {
+  dm_native_job_free(p->job);           /* first: it reads the tape */
   free(p->chk);
   dm_native_free(p->nat);
   dm_tape_free(p->tape);
@@ -123,7 +124,8 @@ int dm_bundle_compile(dm_bundle *p, const dm_bundle_src *src, size_t nout, const
       p->chk[p->nchk++] = oreg[k];
     }
   free(seen);
-  if (src->native == DM_NATIVE_NEVER) {
+  const int mode = src->native & 0xff;
+  if (mode == DM_NATIVE_NEVER) {
     free(inmap);
     free(outmap);
     return DM_OK;
@@ -131,17 +133,77 @@ int dm_bundle_compile(dm_bundle *p, const dm_bundle_src *src, size_t nout, const
   for (size_t i = 0; i < nin; i++)           /* array by array */
     inmap[i] = (dm_native_map){ (uint32_t)i, (uint32_t)(i / n), (uint32_t)(i % n) };
   dm_err nerr;
-  s = dm_native_compile_mapped(p->tape, src->in0, src->par0, inmap, nmap,
-                               outmap, &p->nat, &nerr);
+  if (mode == DM_NATIVE_AUTO && (src->native & DM_BUNDLE_BACKGROUND)) {
+    /* queued: the tape runs until dm_bundle_update installs the code; a
+     * compiler that cannot be started leaves the tape */
+    if (dm_native_job_start(p->tape, src->in0, src->par0, nmap ? inmap : NULL, nmap,
+                            nmap ? outmap : NULL, &p->job, &nerr) != DM_OK) {
+      p->native_failed = 1;
+      p->native_err = nerr;
+    }
+    free(inmap);
+    free(outmap);
+    return DM_OK;
+  }
+  if (nmap > 0)
+    s = dm_native_compile_mapped(p->tape, src->in0, src->par0, inmap, nmap,
+                                 outmap, &p->nat, &nerr);
+  else
+    s = dm_native_compile(p->tape, src->in0, src->par0, &p->nat, &nerr);
   free(inmap);
   free(outmap);
   if (s == DM_OK) {
     p->fn = dm_native_function(p->nat);
     p->scatter = dm_native_scatter(p->nat);
-  } else if (src->native == DM_NATIVE_ALWAYS || s == DM_EINTR) {
+  } else if (mode == DM_NATIVE_ALWAYS || (s == DM_EINTR && mode != DM_NATIVE_WAIT)) {
     if (err != NULL)
       *err = nerr;
     return s;
+  } else {
+    p->native_failed = 1;
+    p->native_err = nerr;
   }
-  return DM_OK;             /* auto: the tape runs, silently */
+  return DM_OK;             /* auto, wait: the tape runs, silently */
+}
+
+int dm_bundle_update(dm_bundle *p)
+{
+  if (p->job == NULL)
+    return 0;
+  int st = dm_native_job_state(p->job);
+  if (st == DM_NATIVE_JOB_QUEUED || st == DM_NATIVE_JOB_RUNNING)
+    return 0;
+  dm_native *nat = dm_native_job_take(p->job, &p->native_err);
+  dm_native_job_free(p->job);
+  p->job = NULL;
+  if (nat == NULL) {
+    p->native_failed = 1;
+    return 0;
+  }
+  p->nat = nat;
+  p->fn = dm_native_function(nat);
+  p->scatter = dm_native_scatter(nat);
+  return 1;
+}
+
+int dm_bundle_cancel(dm_bundle *p, dm_err *err)
+{
+  if (p->job == NULL)
+    return DM_OK;
+  dm_native_job_free(p->job);
+  p->job = NULL;
+  p->native_failed = 1;
+  dm_err_set(&p->native_err, DM_EINTR, "native: compilation cancelled");
+  if (err != NULL)
+    *err = p->native_err;
+  return DM_EINTR;
+}
+
+int dm_bundle_wait(dm_bundle *p, int interruptible, dm_err *err)
+{
+  if (p->job == NULL)
+    return DM_OK;
+  int s = dm_native_job_wait(p->job, interruptible, err);
+  dm_bundle_update(p);
+  return s;
 }

@@ -22,8 +22,10 @@
  * thread; it never allocates.
  * Errors (compile): the tape compiler's statuses, DM_ENOMEM, DM_EFAILED for
  * blocks that leave gaps; native code that does not compile is skipped
- * silently with mode auto (the tape runs), an error with always (or
- * DM_EINTR when interrupted).
+ * silently with modes auto and wait (the tape runs), an error with always
+ * (or DM_EINTR when interrupted).  With auto | DM_BUNDLE_BACKGROUND the
+ * bundle compiles its tape and queues the native code (native_job.h); the
+ * bundle runs the tape until dm_bundle_update installs it.
  */
 #ifndef DM_BUNDLE_H
 #define DM_BUNDLE_H
@@ -34,6 +36,7 @@
 
 #include "expr/expr.h"
 #include "expr/native.h"
+#include "expr/native_job.h"
 #include "core/status.h"
 #include "expr/tape.h"
 
@@ -59,8 +62,12 @@ typedef struct dm_bundle_src {
   const dm_expr *par;
   const double *in0;        /* a typical input point, or NULL */
   const double *par0;       /* parameter values, or NULL */
-  int native;               /* enum dm_native_mode */
+  int native;               /* enum dm_native_mode, | DM_BUNDLE_BACKGROUND */
 } dm_bundle_src;
+
+/* With DM_NATIVE_AUTO: compile in the background (install with
+ * dm_bundle_update). */
+#define DM_BUNDLE_BACKGROUND 0x100
 
 typedef struct dm_bundle {
   dm_tape *tape;
@@ -77,6 +84,9 @@ typedef struct dm_bundle {
   size_t nin;                     /* inputs */
   unsigned have;                  /* bits of the arrays it fills */
   unsigned fill;                  /* bits below narr of the arrays it lacks */
+  dm_native_job *job;             /* native code on its way (background) */
+  int native_failed;              /* the background compilation failed */
+  dm_err native_err;              /* and why */
 } dm_bundle;
 
 /* Compile nout outputs out on the first nin inputs of src, stored by the
@@ -86,6 +96,22 @@ typedef struct dm_bundle {
 int dm_bundle_compile(dm_bundle *p, const dm_bundle_src *src, size_t nout, const dm_expr *out,
                       size_t nin, const dm_block *blk, size_t nblk, int exact, dm_err *err);
 void dm_bundle_free(dm_bundle *p);
+/* Background compilation: install native code that has become ready (1),
+ * nothing yet (0: the tape runs on); a failure ends the job, the tape
+ * stays (native_failed, native_err).  Call it between runs or steps,
+ * never while the bundle is being run. */
+int dm_bundle_update(dm_bundle *p);
+/* 1 while a background compilation is queued or running. */
+static inline int dm_bundle_pending(const dm_bundle *p)
+{
+  return p->job != NULL;
+}
+/* Wait for the background compilation and install it; Ctrl-C stops
+ * waiting (interruptible).  DM_OK also when there was none. */
+int dm_bundle_wait(dm_bundle *p, int interruptible, dm_err *err);
+/* Cancel a background compilation (the tape stays); DM_EINTR when there
+ * was one, else DM_OK. */
+int dm_bundle_cancel(dm_bundle *p, dm_err *err);
 
 /* Outputs in order into w + nregs, the inputs being already in w (the
  * tape's first registers).  Returns w + nregs. */

@@ -208,8 +208,9 @@ int dm_lag__compile_bundle(lag_builder *b, dm_bundle *p, size_t nout, const dm_e
                            size_t nin, const dm_block *blk, size_t nblk, int exact)
 {
   const dm_lagrangian_spec *sp = b->sp;
-  dm_bundle_src src = { b->ctx, b->in, sp->n, sp->npar, sp->par, b->in0,
-                        sp->par_values, sp->native };
+  dm_bundle_src src = { b->ctx, b->in, sp->n, sp->npar, sp->par, b->in0, sp->par_values,
+                        sp->native == DM_NATIVE_AUTO ? DM_NATIVE_AUTO | DM_BUNDLE_BACKGROUND
+                                                     : sp->native };
   return dm_bundle_compile(p, &src, nout, out, nin, blk, nblk, exact, b->err);
 }
 
@@ -498,9 +499,9 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
   const dm_block blk[] = { { 0, DM_BLK_VEC, 1, 1, 0, NULL }, { 1, DM_BLK_VEC, n, 1, 0, NULL },
                            { 2, DM_BLK_VEC, n, 1, 0, NULL }, { 3, DM_BLK_SYM, n, 1, 0, NULL },
                            { 4, DM_BLK_FULL, n, 1, 0, NULL }, { 5, DM_BLK_SYM, n, 1, 0, NULL } };
-  if ((s = dm_lag__compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = dm_lag__compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK ||
-      (s = dm_lag__detect_structure(b, d, Lv, n * n, Lvv, d->pat.vq.nnz == 0, n * n, Lvv,
+  /* the bundles in the order their native code is wanted (background
+   * compilation takes them in this order): Stormer-Verlet's force first */
+  if ((s = dm_lag__detect_structure(b, d, Lv, n * n, Lvv, d->pat.vq.nnz == 0, n * n, Lvv,
                                     flags)) != DM_OK)
     goto done;
   if (d->mass_possible) {
@@ -511,11 +512,22 @@ static int build_lagrangian(builder *b, lag_data *d, unsigned *flags)
     const dm_block bq[] = { { 1, DM_BLK_VEC, n, 1, 0, NULL } };
     const dm_block bqv[] = { { 1, DM_BLK_VEC, n, 1, 0, NULL }, { 2, DM_BLK_VEC, n, 1, 0, NULL },
                              { 5, DM_BLK_SYM, n, 1, 0, NULL } };
-    memmove(ow + 1 + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *ow);
-    if ((s = dm_lag__compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) != DM_OK ||
-        (s = dm_lag__compile_bundle(b, &d->qvqq, 2 * n + tri, ow + 1, 2 * n, bqv, 3, 1)) != DM_OK)
+    dm_expr *sep = malloc((2 * n + tri) * sizeof *sep);
+    if (sep == NULL) {
+      s = dm_err_set(b->err, DM_ENOMEM, "out of memory");
+      goto done;
+    }
+    memcpy(sep, ow + 1, 2 * n * sizeof *sep);
+    memcpy(sep + 2 * n, ow + 1 + 2 * n + tri + n * n, tri * sizeof *sep);
+    if ((s = dm_lag__compile_bundle(b, &d->lq, n, ow + 1, n, bq, 1, 1)) == DM_OK)
+      s = dm_lag__compile_bundle(b, &d->qvqq, 2 * n + tri, sep, 2 * n, bqv, 3, 1);
+    free(sep);
+    if (s != DM_OK)
       goto done;
   }
+  if ((s = dm_lag__compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, blk, 6, 1)) != DM_OK ||
+      (s = dm_lag__compile_bundle(b, &d->all, nall, ow, 2 * n, blk, 6, 1)) != DM_OK)
+    goto done;
   dm_lag__select(d);
 done:
   free(out);
@@ -763,6 +775,7 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
   sys->data = d;
   sys->work_size = need * sizeof(double);
   sys->free_data = lag_free;
+  sys->update = dm_lagrangian_update;
   free(b.in);
   free(b.in0);
   return DM_OK;
@@ -789,6 +802,80 @@ int dm_lagrangian_refresh(dm_system *sys, dm_err *err)
     sys->flags &= ~(unsigned)DM_SYS_SEPARABLE;
     sys->mass = NULL;
     d->pat.mass = NULL;
+  }
+  return DM_OK;
+}
+
+/* Every bundle with native code. */
+static int bundles(lag_data *d, dm_bundle **ps)
+{
+  dm_bundle *all[] = { &d->lq, &d->qvqq, &d->grad, &d->all, &d->force, &d->force_all,
+                       &d->constr, &d->constr_all };
+  int k = 0;
+  for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+    if (all[i]->tape != NULL)
+      ps[k++] = all[i];
+  return k;
+}
+
+int dm_lagrangian_update(const dm_system *sys)
+{
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return 0;
+  lag_data *d = sys->data;
+  dm_bundle *ps[8];
+  int k = bundles(d, ps), installed = 0, pending = 0;
+  for (int i = 0; i < k; i++) {
+    installed |= dm_bundle_update(ps[i]);
+    pending |= dm_bundle_pending(ps[i]);
+  }
+  if (installed)
+    dm_lag__select(d);       /* native code is preferred where it is */
+  return pending;
+}
+
+int dm_lagrangian_wait_native(const dm_system *sys, int interruptible, dm_err *err)
+{
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return dm_err_set(err, DM_EINVAL, "not a system compiled from a Lagrangian");
+  lag_data *d = sys->data;
+  dm_bundle *ps[8];
+  int k = bundles(d, ps), s = DM_OK;
+  for (int i = 0; i < k; i++) {
+    dm_err e;
+    int si = s == DM_EINTR ? dm_bundle_cancel(ps[i], &e) : dm_bundle_wait(ps[i], interruptible, &e);
+    if (si != DM_OK && s == DM_OK) {
+      s = si;
+      if (err != NULL)
+        *err = e;
+    }
+  }
+  for (int i = 0; i < k && s == DM_OK; i++)
+    if (ps[i]->native_failed) {
+      s = ps[i]->native_err.status ? ps[i]->native_err.status : DM_EFAILED;
+      if (err != NULL)
+        *err = ps[i]->native_err;
+    }
+  dm_lagrangian_update(sys);
+  return s;
+}
+
+int dm_lagrangian_native_state(const dm_system *sys, dm_lagrangian_native *ns, dm_err *err)
+{
+  memset(ns, 0, sizeof *ns);
+  if (sys == NULL || sys->free_data != lag_free || sys->data == NULL)
+    return dm_err_set(err, DM_EINVAL, "not a system compiled from a Lagrangian");
+  lag_data *d = sys->data;
+  dm_bundle *ps[8];
+  int k = bundles(d, ps), told = 0;
+  for (int i = 0; i < k; i++) {
+    ns->native += ps[i]->nat != NULL;
+    ns->pending += ps[i]->job != NULL;
+    ns->failed += ps[i]->native_failed;
+    if (ps[i]->native_failed && !told && err != NULL) {
+      *err = ps[i]->native_err;
+      told = 1;
+    }
   }
   return DM_OK;
 }

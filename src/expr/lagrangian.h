@@ -104,6 +104,25 @@ int dm_lagrangian_force_outputs(dm_expr_ctx *ctx, size_t n, const dm_expr *F,
  * is not constant in q and v).  DM_EINVAL if sys was not made here. */
 int dm_lagrangian_refresh(dm_system *sys, dm_err *err);
 
+/* Native code with native = auto is compiled in the background (one
+ * worker thread per process, native_job.h), the bundles the integrators
+ * need first (Stormer-Verlet's force) first, while the tapes run; sys->update
+ * (this function) installs what is ready, between steps (the run driver
+ * calls it between pieces of a run).  Returns 1 while some is still on its
+ * way.  A compilation that fails leaves the tape, with its message. */
+int dm_lagrangian_update(const dm_system *sys);
+/* Wait for the background compilation and install it; with interruptible,
+ * Ctrl-C stops waiting (the compilation is cancelled, DM_EINTR).  DM_OK
+ * when native code runs everywhere it was compiled for; else the first
+ * failure's status and message (the tape runs there). */
+int dm_lagrangian_wait_native(const dm_system *sys, int interruptible, dm_err *err);
+/* Where native code stands: bundles running it, still compiling, failed
+ * (with the first failure's message in err when there is one). */
+typedef struct dm_lagrangian_native {
+  int native, pending, failed;
+} dm_lagrangian_native;
+int dm_lagrangian_native_state(const dm_system *sys, dm_lagrangian_native *ns, dm_err *err);
+
 /* What was built (for diagnostics and benchmarks). */
 typedef struct dm_lagrangian_stats {
   size_t ninstr_grad, ninstr_all;     /* tape sizes */

@@ -168,9 +168,8 @@ int dm_lag__build_sparse(lag_builder *b, lag_data *d, unsigned *flags)
     if (blk[0].pos[2 * k + 1] != DM_BLK_NOPOS)
       mout[blk[0].pos[2 * k + 1]] = blk[0].x[k];
   }
-  if ((s = dm_lag__compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, bl, 6, 1)) != DM_OK ||
-      (s = dm_lag__compile_bundle(b, &d->all, nall, ow, 2 * n, bl, 6, 1)) != DM_OK ||
-      (s = dm_lag__detect_structure(b, d, out + 1 + n, blk[0].ne, blk[0].x, blk[1].ne == 0,
+  /* in the order their native code is wanted (lagrangian.c) */
+  if ((s = dm_lag__detect_structure(b, d, out + 1 + n, blk[0].ne, blk[0].x, blk[1].ne == 0,
                                     d->pat.vv.nnz, mout, flags)) != DM_OK)
     goto done;
   if (d->mass_possible) {
@@ -185,6 +184,9 @@ int dm_lag__build_sparse(lag_builder *b, lag_data *d, unsigned *flags)
         != DM_OK)
       goto done;
   }
+  if ((s = dm_lag__compile_bundle(b, &d->grad, 1 + 2 * n, ow, 2 * n, bl, 6, 1)) != DM_OK ||
+      (s = dm_lag__compile_bundle(b, &d->all, nall, ow, 2 * n, bl, 6, 1)) != DM_OK)
+    goto done;
   dm_lag__select(d);
 done:
   dm_expr_sparse_free(&H);

@@ -48,13 +48,14 @@ const char *dm_native_mode_name(int mode)
   case DM_NATIVE_NEVER: return "never";
   case DM_NATIVE_AUTO: return "auto";
   case DM_NATIVE_ALWAYS: return "always";
+  case DM_NATIVE_WAIT: return "wait";
   default: return "?";
   }
 }
 
 int dm_native_mode_parse(const char *name)
 {
-  for (int m = DM_NATIVE_NEVER; m <= DM_NATIVE_ALWAYS; m++)
+  for (int m = DM_NATIVE_NEVER; m <= DM_NATIVE_WAIT; m++)
     if (name != NULL && strcmp(name, dm_native_mode_name(m)) == 0)
       return m;
   return -1;
@@ -260,9 +261,9 @@ static int parallelism(void)
 
 static int compile_native(const dm_tape *t, const double *in0,
                           const double *par0, dm_native *nat, dm_native_srcs *srcs,
-                          dm_err *err)
+                          const dm_native_env *env, dm_err *err)
 {
-  const char *cc = getenv("CC");
+  const char *cc = env ? env->cc : getenv("CC");
   char cccopy[1024], *ccargv[32];
   snprintf(cccopy, sizeof cccopy, "%s", cc && *cc ? cc : "cc");
   int ncc = dm_native__cc_words(cccopy, ccargv, 30);
@@ -319,7 +320,7 @@ static int compile_native(const dm_tape *t, const double *in0,
   strcpy(full + len, idline);
   srcs->src[srcs->n - 1] = full;
 
-  const char *tmpd = getenv("TMPDIR");
+  const char *tmpd = env ? env->tmpdir : getenv("TMPDIR");
   char dir[4096], obj[4200];
   snprintf(dir, sizeof dir, "%s/dmech-XXXXXX", tmpd && *tmpd ? tmpd : "/tmp");
   if (mkdtemp(dir) == NULL)
@@ -342,10 +343,10 @@ static int compile_native(const dm_tape *t, const double *in0,
   return verify(t, nat, in0, par0, err);
 }
 
-static int compile_with(const dm_tape *t, const double *in0,
-                        const double *par0, const dm_native_map *inmap,
-                        size_t nmap, const dm_native_map *outmap,
-                        dm_native **natp, dm_err *err)
+int dm_native__compile_with(const dm_tape *t, const double *in0,
+                            const double *par0, const dm_native_map *inmap,
+                            size_t nmap, const dm_native_map *outmap,
+                            const dm_native_env *env, dm_native **natp, dm_err *err)
 {
   *natp = NULL;
   for (size_t j = 0; j < nmap; j++)
@@ -365,7 +366,7 @@ static int compile_with(const dm_tape *t, const double *in0,
   nat->inmap = inmap;
   nat->outmap = outmap;
   nat->nmap = nmap;
-  int s = compile_native(t, in0, par0, nat, &srcs, err);
+  int s = compile_native(t, in0, par0, nat, &srcs, env, err);
   dm_native__srcs_free(&srcs);
   nat->inmap = nat->outmap = NULL;      /* the caller's: not kept */
   if (s != DM_OK) {
@@ -379,7 +380,7 @@ static int compile_with(const dm_tape *t, const double *in0,
 int dm_native_compile(const dm_tape *t, const double *in0, const double *par0,
                       dm_native **natp, dm_err *err)
 {
-  return compile_with(t, in0, par0, NULL, 0, NULL, natp, err);
+  return dm_native__compile_with(t, in0, par0, NULL, 0, NULL, NULL, natp, err);
 }
 
 int dm_native_compile_mapped(const dm_tape *t, const double *in0,
@@ -389,5 +390,5 @@ int dm_native_compile_mapped(const dm_tape *t, const double *in0,
 {
   if (inmap == NULL || (nmap && outmap == NULL))
     return dm_err_set(err, DM_EINVAL, "native: maps missing");
-  return compile_with(t, in0, par0, inmap, nmap, outmap, natp, err);
+  return dm_native__compile_with(t, in0, par0, inmap, nmap, outmap, NULL, natp, err);
 }

@@ -51,11 +51,15 @@
 #include "core/status.h"
 #include "expr/tape.h"
 
-/* What the caller wants (dm.config.native). */
+/* What the caller wants (dm.config.native).  What "auto" means is the
+ * caller's: compiled Lagrangians run the tape at once and compile in the
+ * background (native_job.h); other users of bundles compile at once. */
 enum dm_native_mode {
   DM_NATIVE_NEVER = 0,  /* always the tape */
   DM_NATIVE_AUTO,       /* native when a compiler works, else the tape, silently */
-  DM_NATIVE_ALWAYS      /* native or an error */
+  DM_NATIVE_ALWAYS,     /* native or an error, compiled before anything runs */
+  DM_NATIVE_WAIT        /* compiled before anything runs; failing that the
+                           tape, silently (Ctrl-C stops waiting) */
 };
 
 typedef struct dm_native dm_native;
@@ -108,7 +112,8 @@ const char *dm_native_key(const dm_native *nat);
  * memory). */
 char *dm_native_source(const dm_tape *t);
 
-/* "never" / "auto" / "always" and back (-1 for an unknown name). */
+/* "never" / "auto" / "always" / "wait" and back (-1 for an unknown
+ * name). */
 const char *dm_native_mode_name(int mode);
 int dm_native_mode_parse(const char *name);
 

@@ -25,6 +25,18 @@ int dm_native__emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
                     const dm_native_map *outmap, size_t chunk, size_t per_unit,
                     dm_native_srcs *out);
 void dm_native__srcs_free(dm_native_srcs *s);
+/* $CC and $TMPDIR as they were when a background job was started (the
+ * worker thread does not read the environment, which the starting thread
+ * may change); NULL fields: unset. */
+typedef struct dm_native_env {
+  const char *cc, *tmpdir;
+} dm_native_env;
+/* dm_native_compile (inmap NULL) or dm_native_compile_mapped; env NULL:
+ * the environment now. */
+int dm_native__compile_with(const dm_tape *t, const double *in0, const double *par0,
+                            const dm_native_map *inmap, size_t nmap,
+                            const dm_native_map *outmap, const dm_native_env *env,
+                            dm_native **natp, dm_err *err);
 
 /* Split a compiler command at blanks into argv[0..k) (copy is modified). */
 int dm_native__cc_words(char *copy, char **argv, int max);

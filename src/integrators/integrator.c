@@ -250,6 +250,8 @@ int dm_integrator_step(dm_integrator *I, double h, const double *q0, const doubl
   int st;
   if (!isfinite(h))
     return dm_err_set(e, DM_EINVAL, "step size h = %g is not finite", h);
+  if (I->sys->update != NULL)          /* a step boundary: background code */
+    I->sys->update(I->sys);
   if ((st = I->type->step(I, h, q0, p0, q1, p1, e)) != DM_OK)
     return st;
   if (!finite_vec(q1, I->n) || !finite_vec(p1, I->n))

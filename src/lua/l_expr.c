@@ -658,7 +658,7 @@ int dm_lua_native_mode(lua_State *L)
     const char *s = lua_tostring(L, -1);
     mode = s ? dm_native_mode_parse(s) : -1;
     if (mode < 0)
-      luaL_error(L, "dm.config.native must be \"auto\", \"always\" or "
+      luaL_error(L, "dm.config.native must be \"auto\", \"wait\", \"always\" or "
                  "\"never\" (got %s)", luaL_tolstring(L, -1, NULL));
   }
   lua_settop(L, top);

@@ -182,7 +182,7 @@ static int l_fn(lua_State *L)
   int mode = dm_lua_native_mode(L);
   const char *m = dm_optstringfield(L, 1, "native", NULL);
   if (m != NULL && (mode = dm_native_mode_parse(m)) < 0)
-    return luaL_error(L, "dm.fn: native must be \"auto\", \"always\" or "
+    return luaL_error(L, "dm.fn: native must be \"auto\", \"wait\", \"always\" or "
                       "\"never\" (got \"%s\")", m);
 
   dm_err err;
@@ -195,7 +195,8 @@ static int l_fn(lua_State *L)
   if (!f->work || !f->in)
     return luaL_error(L, "out of memory");
   if (mode == DM_NATIVE_ALWAYS ||
-      (mode == DM_NATIVE_AUTO && dm_tape_ninstr(f->tape) >= AUTO_MIN_INSTR)) {
+      ((mode == DM_NATIVE_AUTO || mode == DM_NATIVE_WAIT) &&
+       dm_tape_ninstr(f->tape) >= AUTO_MIN_INSTR)) {
     int s = dm_native_compile(f->tape, NULL, f->par, &f->nat, &err);
     if (s == DM_OK)
       f->fn = dm_native_function(f->nat);

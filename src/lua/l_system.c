@@ -376,7 +376,8 @@ static int native_mode(lua_State *L, int t)
   else if (type != LUA_TNIL)
     mode = -1;
   if (mode < 0)
-    luaL_error(L, "dm.system: native must be \"auto\", \"always\", \"never\" or a boolean");
+    luaL_error(L, "dm.system: native must be \"auto\", \"wait\", \"always\", \"never\" or a "
+               "boolean");
   lua_pop(L, 1);
   return mode;
 }
@@ -470,6 +471,28 @@ static int l_system(lua_State *L)
   return 1;
 }
 
+void dm_lsystem_native(lua_State *L, dm_lsystem *ls, int *native, int *pending,
+                       int want_error)
+{
+  dm_lagrangian_native ns;
+  dm_err e;
+  dm_err_clear(&e);
+  *native = ls->native;
+  *pending = 0;
+  if (ls->traced && dm_lagrangian_native_state(&ls->sys, &ns, NULL) == DM_OK) {
+    dm_lagrangian_update(&ls->sys);
+    dm_lagrangian_native_state(&ls->sys, &ns, &e);
+    *native = ls->native = ns.native > 0;
+    *pending = ns.pending > 0;
+  }
+  if (want_error) {
+    if (e.msg[0])
+      lua_pushstring(L, e.msg);
+    else
+      lua_pushnil(L);
+  }
+}
+
 /* }====================================================================== */
 
 static const dm_reg system_funcs[] = {
@@ -479,7 +502,11 @@ static const dm_reg system_funcs[] = {
    "A mechanical system from a Lagrangian written in Lua (traced once with symbolic q, v, p: "
    "q.r or q[1], v.r, p.J2), with an optional generalized force (a list of n components, "
    "Lagrange-d'Alembert) and holonomic constraints g(q) = 0; every derivative is exact and "
-   "compiled (native per dm.config.native); params given as a map are ordered by name."},
+   "compiled; params given as a map are ordered by name.  native (default dm.config.native): "
+   "\"auto\" runs at once on the tape while native code compiles in the background and "
+   "takes over between steps (sys.compiling, sys.native, sys.native_error); \"wait\" "
+   "compiles first (Ctrl-C: the tape); \"always\" compiles first and fails without a "
+   "compiler; \"never\" keeps the tape."},
   {NULL, NULL, NULL, NULL}
 };
 

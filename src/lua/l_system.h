@@ -90,6 +90,14 @@ const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n);
 long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg);
 long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg);
 
+/* Native code of a traced system compiled in the background: installs
+ * what is ready and says where it stands (native: in use; pending: still
+ * compiling; the first failure's message pushed when want_error, else
+ * nothing pushed).  Systems without a Lagrangian compiled here: their
+ * creation-time flag, nothing pending. */
+void dm_lsystem_native(lua_State *L, dm_lsystem *ls, int *native, int *pending,
+                       int want_error);
+
 /* ---- shared by l_system.c and l_system_obj.c only ---- */
 int dm_lsystem_gc(lua_State *L);
 void dm_lsystem_open_class(lua_State *L);           /* metatables */

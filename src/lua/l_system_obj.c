@@ -279,8 +279,13 @@ static int system_index(lua_State *L)
     lua_getiuservalue(L, 1, 1);
   else if (strcmp(k, "traced") == 0)
     lua_pushboolean(L, ls->traced);
-  else if (strcmp(k, "native") == 0)
-    lua_pushboolean(L, ls->native);
+  else if (strcmp(k, "native") == 0 || strcmp(k, "compiling") == 0 ||
+           strcmp(k, "native_error") == 0) {
+    int nat, pend, want_error = strcmp(k, "native_error") == 0;
+    dm_lsystem_native(L, ls, &nat, &pend, want_error);
+    if (!want_error)
+      lua_pushboolean(L, strcmp(k, "native") == 0 ? nat : pend);
+  }
   else if (strcmp(k, "separable") == 0)
     lua_pushboolean(L, (ls->sys.flags & DM_SYS_SEPARABLE) != 0);
   else if (strcmp(k, "mechanical") == 0)
@@ -289,7 +294,8 @@ static int system_index(lua_State *L)
     lua_pushboolean(L, ls->sys.force != NULL);
   else if (!expr_field(L, ls, k))
     return luaL_error(L, "system has no field or method '%s' (fields: name, n, m, coords, "
-                      "params, cyclic, traced, native, separable, mechanical, forced, q, v, p, "
+                      "params, cyclic, traced, native, compiling, native_error, separable, "
+                      "mechanical, forced, q, v, p, "
                       "L, dLdq, dLdv, d2Ldv2, d2Ldvdq, d2Ldq2, force, constraints)", k);
   return 1;
 }
@@ -323,7 +329,10 @@ static int system_tostring(lua_State *L)
   }
   if (ls->sys.force)
     luaL_addstring(&b, ", forced");
-  luaL_addstring(&b, ls->traced ? (ls->native ? "; traced, native" : "; traced, tape")
+  int nat, pend;
+  dm_lsystem_native(L, ls, &nat, &pend, 0);
+  luaL_addstring(&b, ls->traced ? (nat ? "; traced, native" : pend ? "; traced, compiling"
+                                                                  : "; traced, tape")
                                 : "; built-in C");
   if (ls->sys.flags & DM_SYS_SEPARABLE)
     luaL_addstring(&b, ", separable");

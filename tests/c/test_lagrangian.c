@@ -148,6 +148,8 @@ static void test_bundles(void)
     dm_system s;
     dm_lagrangian_stats ls;
     int st = dm_lagrangian_compile(C, &sp, &s, NULL);
+    if (nat)                    /* compiled in the background: wait */
+      dm_lagrangian_wait_native(&s, 0, NULL);
     dm_lagrangian_stats_get(&s, &ls);
     if (nat && !(ls.native_q && ls.native_sep)) {
       tap_ok(st == DM_OK, "# SKIP no C compiler");
@@ -289,6 +291,7 @@ static void test_dsp(void)
   /* native code: same numbers as the tape */
   dm_system sn;
   st = make_dsp(&sn, DM_NATIVE_AUTO, vars, par, &err);
+  dm_lagrangian_wait_native(&sn, 0, NULL);
   dm_lagrangian_stats_get(&sn, &ls);
   if (ls.native_all) {
     full fn;
@@ -411,6 +414,7 @@ static void test_force_constraints(void)
   dm_system sn;
   sp.native = DM_NATIVE_AUTO;
   st = dm_lagrangian_compile(C, &sp, &sn, &err);
+  dm_lagrangian_wait_native(&sn, 0, NULL);
   dm_lagrangian_stats ls;
   dm_lagrangian_stats_get(&sn, &ls);
   if (st == DM_OK && ls.native_all) {
@@ -477,9 +481,17 @@ static void test_errors(void)
          "native = always without a compiler: %s", err.msg);
   sp.native = DM_NATIVE_AUTO;
   st = dm_lagrangian_compile(C, &sp, &s, &err);
+  dm_err werr;
+  int ws = dm_lagrangian_wait_native(&s, 0, &werr);
   dm_lagrangian_stats ls;
   dm_lagrangian_stats_get(&s, &ls);
   tap_ok(st == DM_OK && !ls.native_all, "native = auto without a compiler: the tape, silently");
+  dm_lagrangian_native ns;
+  dm_err nerr;
+  dm_lagrangian_native_state(&s, &ns, &nerr);
+  tap_ok(ws == DM_ENOTFOUND && ns.failed > 0 && ns.native == 0 && ns.pending == 0 &&
+         strstr(nerr.msg, "/nonexistent/cc"),
+         "the background compilation failed with its message: %s", nerr.msg);
   dm_system_release(&s);
   if (saved) {
     setenv("CC", saved, 1);

@@ -221,6 +221,7 @@ static void test_native(void)
   make_chain(&c, 36, 0);
   int s1 = compile_chain(&c, DM_LAG_LAYOUT_AUTO, DM_NATIVE_NEVER, 1, &st_);
   int s2 = compile_chain(&c, DM_LAG_LAYOUT_AUTO, DM_NATIVE_AUTO, 1, &sn);
+  dm_lagrangian_wait_native(&sn, 0, NULL);
   dm_lagrangian_stats ls;
   dm_lagrangian_stats_get(&sn, &ls);
   if (s1 == DM_OK && s2 == DM_OK && ls.native_all) {

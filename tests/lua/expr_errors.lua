@@ -81,10 +81,10 @@ err("dm.fn: input 1 is a add, symbol or name expected", "dm.fn with an expressio
     function() return dm.fn{inputs = {x + 1}, outputs = x} end)
 err("dm.fn: params must map names to numbers", "dm.fn with bad params",
     function() return dm.fn{inputs = {x}, outputs = x, params = {k = "big"}} end)
-err("dm.fn: native must be \"auto\", \"always\" or \"never\" %(got \"sometimes\"%)", "bad native option",
+err("dm.fn: native must be \"auto\", \"wait\", \"always\" or \"never\" %(got \"sometimes\"%)", "bad native option",
     function() return dm.fn{inputs = {x}, outputs = x, native = "sometimes"} end)
 dm.config.native = "sometimes"
-err("dm.config.native must be \"auto\", \"always\" or \"never\" %(got sometimes%)", "bad dm.config.native",
+err("dm.config.native must be \"auto\", \"wait\", \"always\" or \"never\" %(got sometimes%)", "bad dm.config.native",
     function() return dm.fn{inputs = {x}, outputs = x} end)
 dm.config.native = "never"
 local f = dm.fn{inputs = {x, y}, outputs = x*y, params = {}}
