@@ -54,6 +54,22 @@ void dm_doc_add(lua_State *L, const char *name, const char *sig,
 void dm_newclass(lua_State *L, const char *tname, const char *kind,
                  const dm_reg *methods, const luaL_Reg *meta);
 
+/* A documented field of a class, registered as "<kind>.<name>"; sig NULL
+ * means "<kind>.<name>". */
+typedef struct dm_field {
+  const char *name;
+  const char *sig;   /* "sys.coords -> {name, ...}" */
+  const char *doc;   /* one sentence */
+} dm_field;
+
+/* Document the fields of class `kind` (list terminated by a NULL name). */
+void dm_doc_fields(lua_State *L, const char *kind, const dm_field *fields);
+
+/* The option keys of the documented function `name` (NULL-terminated):
+ * help lists them, the prompt completes them inside the options table, a
+ * misspelt key gets a did-you-mean.  No-op when `name` is not documented. */
+void dm_doc_options(lua_State *L, const char *name, const char *const *keys);
+
 /* Push the docs registry table (name -> {sig=, doc=}). */
 void dm_pushdocs(lua_State *L);
 

@@ -74,6 +74,10 @@ void dm_linteg_open_opts(lua_State *L);
 
 /* Lua functions defined in l_integ_run.c / l_integ_diag.c. */
 int dm_linteg_run(lua_State *L);
+
+/* Record the option keys of dm.integrator and integ:run in the docs. */
+void dm_linteg_doc_options(lua_State *L);
+void dm_linteg_doc_run(lua_State *L);
 extern const dm_reg dm_linteg_diag_funcs[];
 
 #endif

@@ -284,6 +284,21 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
 
 /* }====================================================================== */
 
+/* The keys of dm.integrator's options table, for help and the prompt. */
+void dm_linteg_doc_options(lua_State *L)
+{
+  const char *keys[64];
+  size_t k = 0;
+  const dm_option_desc *d;
+  keys[k++] = "method";
+  keys[k++] = "tableau";
+  for (d = dm_integ_options; d->name != NULL && k + 1 < sizeof keys / sizeof keys[0]; d++)
+    keys[k++] = d->name;
+  keys[k] = NULL;
+  dm_doc_options(L, "dm.integrator", keys);
+  dm_linteg_doc_run(L);
+}
+
 static const luaL_Reg tabbox_meta[] = {{"__gc", tabbox_gc}, {NULL, NULL}};
 
 void dm_linteg_open_opts(lua_State *L)

@@ -104,6 +104,11 @@ static void check_keys(lua_State *L, int o)
   }
 }
 
+void dm_linteg_doc_run(lua_State *L)
+{
+  dm_doc_options(L, "integrator:run", run_keys);
+}
+
 /* The options table at o into r (momentum flags into mom, n bytes). */
 static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int *show,
                          unsigned char *mom)

@@ -572,6 +572,23 @@ static const dm_reg integ_funcs[] = {
   {NULL, NULL, NULL, NULL}
 };
 
+static const dm_field integ_fields[] = {
+  {"h", "integ.h -> number", "The step size (settable: integ.h = 0.01)."},
+  {"method", "integ.method -> string", "The method name as given (\"gauss\", \"gsl:rk8pd\", ...)."},
+  {"family", "integ.family -> string", "The registered family that implements the method."},
+  {"stages", "integ.stages -> integer | nil", "The number of stages, for Runge-Kutta type methods."},
+  {"order", "integ.order -> integer", "The classical order of the method."},
+  {"system", "integ.system -> sys", "The system being integrated."},
+  {"stats", "integ.stats -> table", "Newton statistics of the last step and totals (iters, jacs, residual, tol, steps, iters_total)."},
+  {"summary", "integ.summary -> string", "One line describing the method family."},
+  {"symplectic", "integ.symplectic -> boolean", "True for a symplectic method."},
+  {"symmetric", "integ.symmetric -> boolean", "True for a symmetric (time-reversible) method."},
+  {"explicit", "integ.explicit -> boolean", "True for an explicit method."},
+  {"variational", "integ.variational -> boolean", "True for a variational integrator (a discrete Lagrangian)."},
+  {"exact_jacobian", "integ.exact_jacobian -> boolean", "True when Newton uses the exact Jacobian of the step."},
+  {NULL, NULL, NULL}
+};
+
 void dm_open_integrator(lua_State *L)
 {
   dm_linteg_open_opts(L);
@@ -582,4 +599,6 @@ void dm_open_integrator(lua_State *L)
   lua_pop(L, 1);
   dm_register(L, "dm.", integ_funcs);
   dm_register(L, "dm.", dm_linteg_diag_funcs);
+  dm_doc_fields(L, "integrator", integ_fields);
+  dm_linteg_doc_options(L);
 }

@@ -578,6 +578,7 @@ void dm_open_reduce(lua_State *L)
   lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
   dm_register(L, "dm.", routh_funcs);
+  dm_doc_options(L, "dm.routh", routh_keys);
   for (i = 0; field_docs[i].name; i++)
     dm_doc_add(L, field_docs[i].name, field_docs[i].name, field_docs[i].doc, 0);
 }

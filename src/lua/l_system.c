@@ -510,8 +510,12 @@ static const dm_reg system_funcs[] = {
   {NULL, NULL, NULL, NULL}
 };
 
+static const char *const system_keys[] = {"name", "coords", "params", "L", "force",
+                                          "constraints", "native", NULL};
+
 void dm_open_system(lua_State *L)
 {
   dm_lsystem_open_class(L);
   dm_register(L, "dm.", system_funcs);
+  dm_doc_options(L, "dm.system", system_keys);
 }

@@ -444,6 +444,32 @@ static const dm_reg system_methods[] = {
   {NULL, NULL, NULL, NULL}
 };
 
+static const dm_field system_fields[] = {
+  {"name", "sys.name -> string", "The system's name."},
+  {"n", "sys.n -> integer", "The number of coordinates."},
+  {"m", "sys.m -> integer", "The number of holonomic constraints."},
+  {"coords", "sys.coords -> {name, ...}", "The coordinate names in order."},
+  {"params", "sys.params -> params", "The parameters, read and set by name: sys.params.J2 = 0.05."},
+  {"cyclic", "sys.cyclic -> {name, ...}", "The coordinates that L does not depend on."},
+  {"traced", "sys.traced -> boolean", "True for a system traced from a Lua L (false: built-in C)."},
+  {"native", "sys.native -> boolean", "True when the traced derivatives run as native code (else the tape)."},
+  {"separable", "sys.separable -> boolean", "True when L = 1/2 v.M v - V(q) with a constant M."},
+  {"mechanical", "sys.mechanical -> boolean", "True when L is quadratic in the velocities."},
+  {"forced", "sys.forced -> boolean", "True when the system has a Lagrange-d'Alembert force."},
+  {"q", "sys.q -> symvec", "The traced coordinate symbols (q.x, q[1])."},
+  {"v", "sys.v -> symvec", "The traced velocity symbols (v.x is v_x)."},
+  {"p", "sys.p -> symvec", "The parameter symbols."},
+  {"L", "sys.L -> expr", "The traced Lagrangian, an expression."},
+  {"dLdq", "sys.dLdq -> {expr, ...}", "The derivatives dL/dq, expressions."},
+  {"dLdv", "sys.dLdv -> {expr, ...}", "The momenta dL/dv, expressions."},
+  {"d2Ldv2", "sys.d2Ldv2 -> {{expr, ...}, ...}", "The mass matrix d2L/dv2, expressions."},
+  {"d2Ldvdq", "sys.d2Ldvdq -> {{expr, ...}, ...}", "The mixed derivatives d2L/dvdq, expressions."},
+  {"d2Ldq2", "sys.d2Ldq2 -> {{expr, ...}, ...}", "The second derivatives d2L/dq2, expressions."},
+  {"force", "sys.force -> {expr, ...} | nil", "The traced force, or nil."},
+  {"constraints", "sys.constraints -> {expr, ...} | nil", "The traced constraints g(q) = 0, or nil."},
+  {NULL, NULL, NULL}
+};
+
 void dm_lsystem_open_class(lua_State *L)
 {
   dm_newclass(L, PARAMS_MT, "params", NULL, params_meta);
@@ -453,4 +479,5 @@ void dm_lsystem_open_class(lua_State *L)
   lua_pushcclosure(L, system_index, 1);
   lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
+  dm_doc_fields(L, "system", system_fields);
 }

@@ -3,11 +3,19 @@
  * Two tables live in the Lua registry: "dmech.docs" maps a qualified name
  * ("dm.vec", "vec:dot") to {name=, sig=, doc=}; "dmech.docvals" (weak keys)
  * maps a documented value (a C function) to the same record, so help(v.dot)
- * works without knowing names.
+ * works without knowing names.  A record may carry opts = {"key", ...}, the
+ * option keys of a function taking an options table (help lists them, the
+ * prompt completes them, misspelt ones get a did-you-mean).  Fields of a
+ * class are documented as "<kind>.<field>" beside its "<kind>:<method>"s;
+ * "dmech.classes" maps every class metatable to its kind, so the prompt
+ * can tell dmech's objects from others without calling anything.
  */
 #include <config.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
 
 #include "lua/dmlua.h"
 
@@ -82,6 +90,11 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
     luaL_setfuncs(L, meta, 0);
   lua_pushstring(L, kind);
   lua_setfield(L, -2, "__name");
+  pushregtable(L, "dmech.classes", "k");
+  lua_pushvalue(L, -2);
+  lua_pushstring(L, kind);
+  lua_rawset(L, -3);
+  lua_pop(L, 1);
   if (methods != NULL) {
     lua_newtable(L);
     dm_register(L, prefix, methods);
@@ -103,6 +116,32 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
     lua_pop(L, 1);
     lua_setfield(L, -2, "__methods");   /* for completion and the doc test */
   }
+}
+
+void dm_doc_fields(lua_State *L, const char *kind, const dm_field *fields)
+{
+  char name[128];
+  for (; fields->name != NULL; fields++) {
+    snprintf(name, sizeof name, "%s.%s", kind, fields->name);
+    dm_doc_add(L, name, fields->sig != NULL ? fields->sig : name, fields->doc, 0);
+  }
+}
+
+void dm_doc_options(lua_State *L, const char *name, const char *const *keys)
+{
+  lua_Integer i = 0;
+  dm_pushdocs(L);
+  if (lua_getfield(L, -1, name) != LUA_TTABLE) {
+    lua_pop(L, 2);
+    return;
+  }
+  lua_newtable(L);
+  for (; *keys != NULL; keys++) {
+    lua_pushstring(L, *keys);
+    lua_rawseti(L, -2, ++i);
+  }
+  lua_setfield(L, -2, "opts");
+  lua_pop(L, 2);
 }
 
 /* {======================================================================
@@ -133,7 +172,26 @@ static const dm_reg doc_funcs[] = {
   {NULL, NULL, NULL, NULL}
 };
 
+/* dm._termwidth(): $COLUMNS, else the width of the terminal on stdout,
+ * else nil (help wraps its text to this). */
+static int l_termwidth(lua_State *L)
+{
+  const char *env = getenv("COLUMNS");
+  struct winsize ws;
+  long w = 0;
+  if (env != NULL && *env != '\0')
+    w = strtol(env, NULL, 10);
+  if (w <= 0 && isatty(STDOUT_FILENO) && ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0)
+    w = ws.ws_col;
+  if (w <= 0 || w > 100000)
+    return 0;
+  lua_pushinteger(L, w);
+  return 1;
+}
+
 void dm_open_doc(lua_State *L)
 {
   dm_register(L, "dm.", doc_funcs);
+  lua_pushcfunction(L, l_termwidth);
+  lua_setfield(L, -2, "_termwidth");
 }
