@@ -19,9 +19,14 @@ dm.doc("dm.apropos", "apropos(\"word\")",
 
 local print_ = require "dmech.print"
 dm.pretty = print_.pretty
-dm.doc("dm.pretty", "dm.pretty(x[, depth]) -> string",
-       "The REPL's rendering of a value: tables to depth 3 with truncation, objects by __tostring.",
+dm.show = print_.show
+dm.doc("dm.pretty", "dm.pretty(x[, depth | {depth=, digits=, items=}]) -> string",
+       "The REPL's rendering of a value: tables to depth 3 with truncation, vecs and mats head ... "
+       .. "tail with dm.config.digits (6) significant digits, other objects by __tostring.",
        dm.pretty)
+dm.doc("dm.show", "dm.show(x[, {depth=, digits=, items=}])",
+       "Print a value in full: every digit (shortest round trip) and every element of a vec or mat.",
+       dm.show)
 
 dm.test = require "dmech.test"
 

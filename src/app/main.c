@@ -25,102 +25,16 @@
 #include "app/repl.h"
 #include "app/testrun.h"
 
-static const char *progname = DM_PROGNAME;
-
-/* {======================================================================
- * Ctrl-C: first press stops the running code, a second one quits
- * ======================================================================= */
-
-static lua_State *globalL = NULL;
-static volatile sig_atomic_t sigint_count = 0;
-
-/* Hook set by the signal handler: fires at the next Lua instruction.  If a C
- * loop already consumed the interrupt (it returned its partial result and
- * cleared the flag) there is nothing left to stop. */
-static void lstop(lua_State *L, lua_Debug *ar)
-{
-  (void)ar;
-  lua_sethook(L, NULL, 0, 0);
-  if (dm_interrupted()) {
-    dm_interrupt_clear();
-    luaL_error(L, "interrupted!");
-  }
-}
-
-static void laction(int sig)
-{
-  int flag = LUA_MASKCALL | LUA_MASKRET | LUA_MASKLINE | LUA_MASKCOUNT;
-  if (++sigint_count > 1) {          /* second Ctrl-C in the same run: quit */
-    signal(sig, SIG_DFL);
-    raise(sig);
-    return;
-  }
-  dm_interrupt_raise();
-  lua_sethook(globalL, lstop, flag, 1);
-}
-
-static int msghandler(lua_State *L)
-{
-  const char *msg = lua_tostring(L, 1);
-  if (msg == NULL) {
-    if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING)
-      return 1;
-    msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
-  }
-  luaL_traceback(L, L, msg, 1);
-  return 1;
-}
-
-int dm_docall(lua_State *L, int narg, int nres)
-{
-  int status, base = lua_gettop(L) - narg;
-  struct sigaction sa, old;
-  lua_pushcfunction(L, msghandler);
-  lua_insert(L, base);
-  globalL = L;
-  sigint_count = 0;
-  dm_interrupt_clear();
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = laction;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &old);
-  status = lua_pcall(L, narg, nres, base);
-  sigaction(SIGINT, &old, NULL);
-  lua_sethook(L, NULL, 0, 0);
-  dm_interrupt_clear();
-  lua_remove(L, base);
-  return status;
-}
-
-static void l_message(const char *pname, const char *msg)
-{
-  fflush(stdout);           /* keep stdout and stderr in order in pipes */
-  if (pname)
-    fprintf(stderr, "%s: ", pname);
-  fprintf(stderr, "%s\n", msg);
-  fflush(stderr);
-}
-
-int dm_report(lua_State *L, int status)
-{
-  if (status != LUA_OK) {
-    const char *msg = lua_tostring(L, -1);
-    l_message(progname, msg != NULL ? msg : "(error object is not a string)");
-    lua_pop(L, 1);
-  }
-  return status;
-}
-
-/* }====================================================================== */
+const char *dm_progname = DM_PROGNAME;
 
 static void print_usage(const char *badoption)
 {
   FILE *f = badoption != NULL ? stderr : stdout;
   if (badoption != NULL) {
     if (badoption[1] == 'e' || badoption[1] == 'l')
-      fprintf(f, "%s: '%s' needs argument\n", progname, badoption);
+      fprintf(f, "%s: '%s' needs argument\n", dm_progname, badoption);
     else
-      fprintf(f, "%s: unrecognized option '%s'\n", progname, badoption);
+      fprintf(f, "%s: unrecognized option '%s'\n", dm_progname, badoption);
   }
   fprintf(f,
     "usage: %s [options] [script [args]]\n"
@@ -141,7 +55,7 @@ static void print_usage(const char *badoption)
     "DMECH_PATH adds directories searched for dmech's Lua library;\n"
     "DMECH_GNUPLOT names the gnuplot program.\n"
     "In the interactive prompt: help(x), help \"name\", apropos \"word\".\n",
-    progname, progname);
+    dm_progname, dm_progname);
   fflush(f);
 }
 
@@ -167,7 +81,7 @@ static int collectargs(char **argv, int *first)
   int args = 0, i;
   if (argv[0] != NULL) {
     if (argv[0][0])
-      progname = argv[0];
+      dm_progname = argv[0];
   } else {
     *first = -1;
     return 0;
@@ -278,7 +192,9 @@ static int pushargs(lua_State *L)
   return n;
 }
 
-static int handle_script(lua_State *L, char **argv)
+/* Run the script; with -i (keep) its top-level locals become globals when
+ * it ends, normally or by an error, for the prompt that follows. */
+static int handle_script(lua_State *L, char **argv, int keep)
 {
   int status;
   const char *fname = argv[0];
@@ -287,6 +203,8 @@ static int handle_script(lua_State *L, char **argv)
   status = luaL_loadfile(L, fname);
   if (status == LUA_OK) {
     int n = pushargs(L);
+    if (keep)
+      dm_keep_locals(L, -n - 1);
     status = dm_docall(L, n, LUA_MULTRET);
   }
   return dm_report(L, status);
@@ -357,6 +275,7 @@ static int open_dmech(lua_State *L)
   lua_getfield(L, -1, "apropos");
   lua_setglobal(L, "apropos");
   lua_setglobal(L, "dm");
+  dm_open_errors(L);
   return LUA_OK;
 }
 
@@ -364,7 +283,7 @@ static int pmain(lua_State *L)
 {
   int argc = (int)lua_tointeger(L, 1);
   char **argv = (char **)lua_touserdata(L, 2);
-  int script;
+  int script, failed = 0;
   int args = collectargs(argv, &script);
   luaL_checkversion(L);
   if (args == has_error) {
@@ -395,11 +314,15 @@ static int pmain(lua_State *L)
   if (!runargs(L, argv, script > 0 ? script : argc))
     return 0;
   if (script > 0) {
-    if (handle_script(L, argv + script) != LUA_OK)
+    /* with -i an error in the script leaves us at the prompt */
+    failed = handle_script(L, argv + script, args & has_i) != LUA_OK;
+    if (failed && !(args & has_i))
       return 0;
   }
   if (args & has_i) {
     dm_repl(L);
+    if (failed)            /* as python -i: the script's failure is the status */
+      return 0;
   } else if (script < 1 && !(args & (has_e | has_v))) {
     if (isatty(0)) {
       print_version();
@@ -424,7 +347,7 @@ static void close_stdout(void)
   int pending = __fpending(stdout) != 0, failed = ferror(stdout) != 0;
   int closefail = fclose(stdout) != 0, err = errno;
   if (failed || (closefail && (pending || err != EBADF))) {
-    fprintf(stderr, "%s: write error on standard output%s%s\n", progname,
+    fprintf(stderr, "%s: write error on standard output%s%s\n", dm_progname,
             closefail ? ": " : "", closefail ? strerror(err) : "");
     fflush(stderr);
     _exit(EXIT_FAILURE);
@@ -448,7 +371,7 @@ int main(int argc, char **argv)
     return dm_testrun(argc, argv);  /* `dmech test`: the test runner */
   L = luaL_newstate();
   if (L == NULL) {
-    l_message(argv[0], "cannot create state: not enough memory");
+    dm_message(argv[0], "cannot create state: not enough memory");
     return EXIT_FAILURE;
   }
   lua_pushcfunction(L, pmain);

@@ -11,6 +11,7 @@
  */
 #include <config.h>
 
+#include <ctype.h>
 #include <errno.h>
 #include <poll.h>
 #include <signal.h>
@@ -310,40 +311,140 @@ static int incomplete(lua_State *L, int status)
 /* Does the chunk end with ';' (ignoring trailing blanks)? */
 static int ends_with_semicolon(const char *s, size_t l)
 {
-  while (l > 0 && (s[l - 1] == ' ' || s[l - 1] == '\t' || s[l - 1] == '\r'))
+  while (l > 0 && (s[l - 1] == ' ' || s[l - 1] == '\t' || s[l - 1] == '\r' || s[l - 1] == '\n'))
     l--;
   return l > 0 && s[l - 1] == ';';
 }
 
-/* Try to compile the line on the stack as "return <line>". */
-static int addreturn(lua_State *L)
+/* Compile text as a chunk named stdin: pushes the function and returns
+ * LUA_OK, or returns the status with nothing pushed. */
+static int try_load(lua_State *L, const char *text, size_t len)
 {
-  const char *line = lua_tostring(L, -1);
-  const char *retline = lua_pushfstring(L, "return %s;", line);
-  int status = luaL_loadbuffer(L, retline, strlen(retline), "=stdin");
-  if (status == LUA_OK)
-    lua_remove(L, -2);
-  else
-    lua_pop(L, 2);
+  int status = luaL_loadbuffer(L, text, len, "=stdin");
+  if (status != LUA_OK)
+    lua_pop(L, 1);
   return status;
 }
 
-/* Read more lines while the chunk is incomplete; 0 ok, -1 cancelled. */
-static int multiline(lua_State *L)
+#define KEEP_NAME "__dmech_keep"
+
+/* Compile the chunk in one of its forms (pushed on success, else nothing):
+ * split < 0: the statements as they are; split = p >= 0: the statements
+ * text[0, p) then "return select(1, <text[p, len)>)" -- text[0, p) ends
+ * with ';' or a newline, so line numbers stay those of the text; select
+ * keeps every value and makes the user's call an ordinary call, not a tail
+ * call, so that tracebacks name it.  With keep, the chunk receives a
+ * function as its vararg and calls it once its top-level statements have
+ * run: their locals become globals (dm_keep_caller_locals). */
+static int compile(lua_State *L, const char *text, size_t len, long split, int keep)
 {
+  int status, n = 0;
+  if (keep) {
+    lua_pushliteral(L, "local " KEEP_NAME " = ...; ");
+    n++;
+  }
+  if (split < 0) {
+    lua_pushlstring(L, text, len);
+    n++;
+    if (keep) {
+      lua_pushliteral(L, "\n;" KEEP_NAME "()");
+      n++;
+    }
+  } else {
+    size_t p = (size_t)split;
+    lua_pushlstring(L, text, p);
+    lua_pushstring(L, keep ? ";" KEEP_NAME "() return select(1, " : "return select(1, ");
+    lua_pushlstring(L, text + p, len - p);
+    /* ")" on the same line (errors keep their line) unless a comment may end it */
+    lua_pushstring(L, strstr(lua_tostring(L, -1), "--") != NULL ? "\n);" : ");");
+    n += 4;
+  }
+  lua_concat(L, n);
+  status = try_load(L, lua_tostring(L, -1), lua_rawlen(L, -1));
+  if (status == LUA_OK)
+    lua_remove(L, -2);
+  else
+    lua_pop(L, 1);
+  return status;
+}
+
+/* Where to split the chunk so that the value of its last statement, when
+ * that is an expression, is returned: 0 (the whole text is an expression),
+ * the start of the last statement ("a = 1; a + 1", a pasted block), or -1.
+ * `plain_ok` says the text also compiles as statements; then only splits
+ * that cannot change its meaning are taken (after ';', or before a name:
+ * "y = 1\n-x" is y = 1 - x). */
+static long find_split(lua_State *L, const char *text, size_t len, int plain_ok)
+{
+  size_t p;
+  if (compile(L, text, len, 0, 0) == LUA_OK) {
+    lua_pop(L, 1);
+    return 0;
+  }
+  for (p = len; p > 0; p--) {
+    char c = text[p - 1], d;
+    size_t q = p;
+    if (c != '\n' && c != ';')
+      continue;
+    while (q < len && (text[q] == ' ' || text[q] == '\t' || text[q] == '\r' || text[q] == '\n'))
+      q++;
+    if (q == len)
+      continue;
+    d = text[q];
+    if (plain_ok && c != ';' && !(isalpha((unsigned char)d) || d == '_'))
+      continue;
+    if (compile(L, text + p, len - p, 0, 0) != LUA_OK)
+      continue;                                   /* the tail is not an expression */
+    lua_pop(L, 1);
+    if (try_load(L, text, p) != LUA_OK)
+      continue;                                   /* the head is not whole statements */
+    lua_pop(L, 1);
+    if (compile(L, text, len, (long)p, 0) == LUA_OK) {
+      lua_pop(L, 1);
+      return (long)p;
+    }
+  }
+  return -1;
+}
+
+/* Read a whole chunk; on success the stack is [chunk text, function]: the
+ * function takes one argument, the keeper of its locals
+ * (dm_keep_caller_locals), which it may ignore.  *expr tells whether it
+ * returns the value of its last expression (printed unless *quiet: the
+ * chunk ends with ';').  Returns the load status, -1 at end of input, -2
+ * when Ctrl-C cancelled the input. */
+static int loadchunk(lua_State *L, int *expr, int *quiet)
+{
+  int status, r;
+  size_t len, l;
+  long split;
+  const char *text;
   for (;;) {
-    size_t len;
-    const char *line = lua_tolstring(L, 1, &len);
-    int status = luaL_loadbuffer(L, line, len, "=stdin");
-    int r;
+    text = lua_tolstring(L, 1, &len);
+    *quiet = ends_with_semicolon(text, len);
+    /* "x;" is not an expression: look at the text without its ';'s */
+    l = len;
+    while (*quiet && l > 0 && strchr(" \t\r\n;", text[l - 1]) != NULL)
+      l--;
+    status = try_load(L, text, len);
+    if (status == LUA_OK)
+      lua_pop(L, 1);
+    split = find_split(L, text, l, status == LUA_OK);
+    if (split >= 0 || status == LUA_OK) {
+      *expr = split >= 0;
+      if (compile(L, text, split >= 0 ? l : len, split, 1) == LUA_OK
+          || compile(L, text, split >= 0 ? l : len, split, 0) == LUA_OK)
+        return LUA_OK;
+    }
+    *expr = 0;
+    status = luaL_loadbuffer(L, text, len, "=stdin");
     if (!incomplete(L, status))
       return status;
     r = pushline(L, 0);
     if (r <= 0) {
       if (r == 0)    /* end of input inside a chunk: report the syntax error */
-        return luaL_loadbuffer(L, line, len, "=stdin");
-      lua_settop(L, 0);
-      return -1;
+        return luaL_loadbuffer(L, text, len, "=stdin");
+      return -2;
     }
     lua_pushliteral(L, "\n");
     lua_insert(L, -2);
@@ -351,14 +452,47 @@ static int multiline(lua_State *L)
   }
 }
 
+/* A bare word the prompt understands when it names no variable: help, exit,
+ * quit (also as help(), exit(), quit()). */
+static const char *command_word(lua_State *L, const char *line)
+{
+  static const char *const words[] = {"help", "exit", "quit", NULL};
+  size_t n;
+  int i;
+  while (*line == ' ' || *line == '\t')
+    line++;
+  for (i = 0; words[i] != NULL; i++) {
+    const char *rest;
+    n = strlen(words[i]);
+    if (strncmp(line, words[i], n) != 0)
+      continue;
+    rest = line + n;
+    if (strncmp(rest, "()", 2) == 0 && i > 0)
+      rest += 2;
+    while (*rest == ' ' || *rest == '\t' || *rest == ';')
+      rest++;
+    if (*rest != '\0')
+      continue;
+    if (i > 0) {             /* exit/quit unless the user defined them */
+      int defined = lua_getglobal(L, words[i]) != LUA_TNIL;
+      lua_pop(L, 1);
+      if (defined)
+        return NULL;
+    }
+    return words[i];
+  }
+  return NULL;
+}
+
 /* Read a whole chunk; on success the stack is [line, function]; returns the
- * load status, -1 on end of input, -2 when Ctrl-C cancelled the input.  *expr
- * tells whether the chunk is an expression (its results are printed). */
+ * load status, -1 on end of input, -2 when Ctrl-C cancelled the input, -3
+ * for the bare word `help`.  *expr tells whether the chunk is an expression
+ * (its results are printed). */
 static int loadline(lua_State *L, int *expr, int *quiet)
 {
   int status, r;
   size_t len;
-  const char *line;
+  const char *line, *word;
   lua_settop(L, 0);
   r = pushline(L, 1);
   if (r == 0)
@@ -371,26 +505,18 @@ static int loadline(lua_State *L, int *expr, int *quiet)
     lua_replace(L, 1);
   }
   line = lua_tolstring(L, 1, &len);
-  *quiet = ends_with_semicolon(line, len);
-  *expr = 1;
-  if (*quiet) {           /* "return x;;" is not Lua: try without the ';' */
-    size_t l = len;
-    while (line[l - 1] != ';')
-      l--;
-    lua_pushlstring(L, line, l - 1);
-  } else {
-    lua_pushvalue(L, 1);
+  if ((word = command_word(L, line)) != NULL) {
+#ifdef HAVE_READLINE
+    if (use_readline)
+      history_add(line);
+#endif
+    return word[0] == 'h' ? -3 : -1;
   }
-  if ((status = addreturn(L)) != LUA_OK) {
-    *expr = 0;
-    lua_settop(L, 1);
-    status = multiline(L);
-    if (status == -1)
-      return -2;
-  } else {
-    lua_remove(L, -2);    /* the copy of the line */
-  }
+  status = loadchunk(L, expr, quiet);
+  if (status == -2)
+    return -2;
   line = lua_tolstring(L, 1, &len);
+  dm_set_chunk(L, line, len);
 #ifdef HAVE_READLINE
   if (use_readline)
     history_add(line);
@@ -418,15 +544,47 @@ static void print_results(lua_State *L)
     dm_report(L, LUA_ERRRUN);
 }
 
+#ifdef HAVE_READLINE
+/* A bracketed paste that ends with a newline runs at once (as typed lines
+ * would); without the newline it stays on the line for editing. */
+static int paste_and_run(int count, int key)
+{
+  int r = rl_bracketed_paste_begin(count, key);
+  if (rl_end > 0 && rl_line_buffer[rl_end - 1] == '\n') {
+    rl_end--;
+    rl_line_buffer[rl_end] = '\0';
+    if (rl_point > rl_end)
+      rl_point = rl_end;
+    rl_newline(1, '\n');
+  }
+  return r;
+}
+#endif
+
+/* help() through the global, as if typed. */
+static void bare_help(lua_State *L)
+{
+  lua_settop(L, 0);
+  if (lua_getglobal(L, "help") == LUA_TFUNCTION) {
+    if (dm_docall(L, 0, 0) != LUA_OK)
+      dm_report(L, LUA_ERRRUN);
+  }
+  lua_settop(L, 0);
+}
+
 void dm_repl(lua_State *L)
 {
   int status, expr = 0, quiet = 0;
+  dm_set_interactive(L, 1);
 #ifdef HAVE_READLINE
   use_readline = isatty(STDIN_FILENO) && open_sigpipe() == 0;
   if (use_readline) {
     rl_readline_name = DM_PROGNAME;
     rl_catch_signals = 0;
     rl_catch_sigwinch = 0;
+    rl_initialize();
+    rl_bind_keyseq_in_map("\033[200~", paste_and_run, emacs_standard_keymap);
+    rl_bind_keyseq_in_map("\033[200~", paste_and_run, vi_insertion_keymap);
     dm_complete_init(L);
     history_open();
   }
@@ -437,9 +595,15 @@ void dm_repl(lua_State *L)
       break;
     if (status == -2)
       continue;
+    if (status == -3) {
+      bare_help(L);
+      continue;
+    }
     lua_remove(L, 1);                        /* the line text */
-    if (status == LUA_OK)
-      status = dm_docall(L, 0, LUA_MULTRET);
+    if (status == LUA_OK) {
+      lua_pushcfunction(L, dm_keep_caller_locals);
+      status = dm_docall(L, 1, LUA_MULTRET);
+    }
     if (status == LUA_OK) {
       if (expr && lua_gettop(L) > 0) {
         lua_pushvalue(L, 1);
@@ -452,6 +616,7 @@ void dm_repl(lua_State *L)
     }
   }
   lua_settop(L, 0);
+  dm_set_interactive(L, 0);
   if (use_readline || isatty(STDIN_FILENO))
     fputs("\n", stdout);
   fflush(stdout);

@@ -274,9 +274,10 @@ static int t_tostring(lua_State *L)
   lua_pushfstring(L, "<Trajectory %I sample%s", (lua_Integer)len, len == 1 ? "" : "s");
   luaL_addvalue(&b);
   if (len > 0) {
-    dm_num_format(a, sizeof a, dm_traj_col(tr, 0)[0]);
-    dm_num_format(z, sizeof z, dm_traj_col(tr, 0)[len - 1]);
-    lua_pushfstring(L, " t=[%s,%s]", a, z);
+    /* ten digits: the end of a run reads 79289.95, not 79289.95000000001 */
+    dm_num_snprintf(a, sizeof a, "%.10g", dm_traj_col(tr, 0)[0]);
+    dm_num_snprintf(z, sizeof z, "%.10g", dm_traj_col(tr, 0)[len - 1]);
+    lua_pushfstring(L, " t=[%s, %s]", a, z);
     luaL_addvalue(&b);
   }
   sys = dm_traj_meta_get(tr, "system");
@@ -658,6 +659,14 @@ static const dm_reg traj_methods[] = {
   {NULL, NULL, NULL, NULL}
 };
 
+static const dm_field traj_fields[] = {
+  {"t", "traj.t -> vec", "The times of the samples (the same as traj:column(\"t\"))."},
+  {"q", "traj.q -> columns", "The coordinate columns by name or number: traj.q.x, traj.q[1] (vecs)."},
+  {"p", "traj.p -> columns", "The momentum columns by coordinate name or number, when recorded."},
+  {"v", "traj.v -> columns", "The velocity columns by coordinate name or number, when recorded."},
+  {NULL, NULL, NULL}
+};
+
 static const luaL_Reg traj_meta[] = {
   {"__index", t_index},
   {"__len", t_len},
@@ -684,6 +693,7 @@ void dm_open_traj(lua_State *L)
 {
   dm_newclass(L, DM_TRAJ_MT, "trajectory", traj_methods, traj_meta);
   lua_pop(L, 1);
+  dm_doc_fields(L, "trajectory", traj_fields);
   luaL_newmetatable(L, COLS_MT);
   luaL_setfuncs(L, cols_meta, 0);
   lua_pushliteral(L, "trajectory columns");

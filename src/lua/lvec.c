@@ -368,9 +368,7 @@ static int arith(lua_State *L, char op)
     lua_call(L, 2, 1);
     return 1;
   }
-  getoperands(L, opname, &o);
-  if ((op == '+' || op == '-') && o.b == NULL)
-    return luaL_error(L, "vec %s number: use a vec of equal length (no broadcasting)", opname);
+  getoperands(L, opname, &o);     /* a number broadcasts: v + 1, 2 - v, 3 * v */
   r = dm_pushvec(L, o.a->size);
   for (i = 0; i < r->size; i++) {
     double x = gsl_vector_get(o.a, i);
@@ -467,20 +465,27 @@ static const luaL_Reg vec_meta[] = {
   {NULL, NULL}
 };
 
-/* dm.format_number(x): the text every number of dmech is printed and
- * written as (core/numfmt.h) */
+/* dm.format_number(x[, digits]): the text every number of dmech is printed
+ * and written as (core/numfmt.h), or "%.<digits>g" in the C locale */
 static int l_format_number(lua_State *L)
 {
   char buf[DM_NUM_BUFSIZE];
   double x = luaL_checknumber(L, 1);
-  lua_pushstring(L, (dm_num_format(buf, sizeof buf, x), buf));
+  lua_Integer digits = luaL_optinteger(L, 2, 0);
+  luaL_argcheck(L, digits >= 0 && digits <= 17, 2, "digits from 1 to 17 expected (0: shortest)");
+  if (digits == 0)
+    dm_num_format(buf, sizeof buf, x);
+  else
+    dm_num_snprintf(buf, sizeof buf, "%.*g", (int)digits, x);
+  lua_pushstring(L, buf);
   return 1;
 }
 
 static const dm_reg vec_funcs[] = {
-  {"format_number", l_format_number, "dm.format_number(x) -> string",
+  {"format_number", l_format_number, "dm.format_number(x[, digits]) -> string",
    "The shortest decimal that reads back as exactly x (\"0.1\", \"2.385\", \"1e-300\", "
-   "\"nan\", \"inf\"), with '.' whatever the locale: how dmech prints and writes numbers."},
+   "\"nan\", \"inf\"), or x to that many significant digits (%g), with '.' whatever the "
+   "locale: how dmech prints and writes numbers."},
   {"vec", l_vec, "dm.vec(n | {x1, ...} | v | x1, x2, ...) -> vec",
    "A vector of n zeros, or of the given numbers (a copy when given a vec)."},
   {"linspace", l_linspace, "dm.linspace(a, b, n) -> vec",

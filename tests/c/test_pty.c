@@ -1,7 +1,10 @@
 /* test_pty.c -- drive the interactive dmech through a pseudo-terminal:
  * tab completion (dm.v<TAB>, v:<TAB>), Ctrl-C at the prompt, Ctrl-C inside
  * `while true do end` keeping variables, a second Ctrl-C quitting, and
- * history (one entry per multi-line chunk) persisted across two sessions. */
+ * history (one entry per multi-line chunk) persisted across two sessions;
+ * completion of fields, of names and files inside strings and of option
+ * keys, help wrapped to the terminal's width, a bracketed paste run
+ * statement by statement, the bare words help and quit. */
 #include <config.h>
 
 #include <errno.h>
@@ -30,23 +33,53 @@ typedef struct session {
 
 static const char *dmech, *tmp;
 
-static int start(session *s, const char *statedir)
+/* dmech on a new pty of `cols` columns with TERM=term. */
+static int start_term(session *s, const char *statedir, const char *term, unsigned short cols)
 {
   struct winsize ws = {24, 100, 0, 0};
+  ws.ws_col = cols;
   s->len = 0;
   s->buf[0] = '\0';
   s->pid = forkpty(&s->fd, NULL, NULL, &ws);
   if (s->pid < 0)
     return -1;
   if (s->pid == 0) {
-    setenv("TERM", "dumb", 1);
+    setenv("TERM", term, 1);
     setenv("INPUTRC", "/dev/null", 1);
     setenv("HOME", tmp, 1);
     setenv("XDG_STATE_HOME", statedir, 1);
+    unsetenv("COLUMNS");
+    if (chdir(tmp) != 0)
+      _exit(126);
     execl(dmech, dmech, (char *)NULL);
     _exit(127);
   }
   return 0;
+}
+
+static int start(session *s, const char *statedir)
+{
+  return start_term(s, statedir, "dumb", 100);
+}
+
+/* The longest line (in bytes, escapes excluded) of buf[from, to). */
+static size_t longest_line(const char *buf, size_t from, size_t to)
+{
+  size_t best = 0, cur = 0, i;
+  for (i = from; i < to; i++) {
+    unsigned char c = (unsigned char)buf[i];
+    if (c == '\n' || c == '\r') {
+      cur = 0;
+    } else if (c == 0x1b) {                   /* skip an escape sequence */
+      while (i + 1 < to && !((buf[i + 1] >= 'A' && buf[i + 1] <= 'Z') || (buf[i + 1] >= 'a' && buf[i + 1] <= 'z')))
+        i++;
+      i++;
+    } else if ((c & 0xc0) != 0x80) {          /* count characters, not bytes */
+      if (++cur > best)
+        best = cur;
+    }
+  }
+  return best;
 }
 
 /* Read until `want` appears after position `from` (or timeout); 1 if seen. */
@@ -244,6 +277,103 @@ int main(void)
   EXPECT(&s, mark, "k1 k2", "a multi-line chunk is recalled as one entry");
   send(&s, "\x04");
   finish(&s, &status);
+
+  /* ---- completion of fields, strings and options; help; paste ---- */
+  if (start_term(&s, state, "dumb", 60) != 0)
+    return tap_done();
+  EXPECT(&s, 0, "dm> ", "fourth session prompt (60 columns)");
+  {
+    char cmd[2048];
+    FILE *tf;
+    mark = s.len;
+    send(&s, "sys = dm.systems.kepler(); I = dm.integrator(sys, {h = 0.05})\r");
+    EXPECT(&s, mark, "dm> ", "a system and an integrator");
+    mark = s.len;
+    send(&s, "sys.coo\t");
+    EXPECT(&s, mark, "sys.coords", "sys.coo<TAB> completes a data field");
+    send(&s, "\r");
+    EXPECT(&s, mark, "{\"x\", \"y\"}", "the completed field runs");
+    mark = s.len;
+    send(&s, "I.fam\t");
+    EXPECT(&s, mark, "I.family", "I.fam<TAB> completes an integrator field");
+    mark = s.len;
+    send(&s, "\x03");
+    EXPECT(&s, mark, "dm> ", "Ctrl-C clears the completed line");
+    mark = s.len;
+    send(&s, "tr = I:run({q = {0.4, 0}, p = {0, 2}}, {steps = 20, ev\t");
+    EXPECT(&s, mark, "ev" "ery = ", "an option key of integ:run completes with ' = '");
+    send(&s, "2})\r");
+    EXPECT(&s, mark, "dm> ", "the run with the completed option");
+    mark = s.len;
+    send(&s, "tr:column(\"ene\t");
+    EXPECT(&s, mark, "\"energy\"", "a column name inside a string, the string closed");
+    send(&s, "):max() > -1e300\r");
+    EXPECT(&s, mark, "true", "the completed column reads");
+    mark = s.len;
+    send(&s, "dm.plot{ {tr, \"x\", \"p_\t\t");
+    EXPECT(&s, mark, "p_y", "column names of a plot spec listed");
+    mark = s.len;
+    send(&s, "\x03");
+    EXPECT(&s, mark, "dm> ", "Ctrl-C clears the plot line");
+    mark = s.len;
+    send(&s, "dm.integrator(sys, {met\t");
+    EXPECT(&s, mark, "method = ", "an option key inside the options table of dm.integrator");
+    mark = s.len;
+    send(&s, "\x03");
+    EXPECT(&s, mark, "dm> ", "Ctrl-C clears the option line");
+    mark = s.len;
+    send(&s, "dm.\t\t");
+    EXPECT(&s, mark, "dm.vec", "dm.<TAB><TAB> lists dm");
+    mark = (size_t)(strstr(s.buf + mark, "dm.vec") - s.buf);
+    EXPECT(&s, mark, "dm> dm.", "the line after the list");
+    tap_ok(strstr(s.buf + mark - 2000 > s.buf ? s.buf + mark - 2000 : s.buf, "dm._gp") == NULL,
+           "internal names (dm._gp) hidden");
+    mark = s.len;
+    send(&s, "\x03");
+    EXPECT(&s, mark, "dm> ", "Ctrl-C clears the dm. line");
+    snprintf(cmd, sizeof cmd, "%s/pty-completion-target.lua", tmp);
+    tf = fopen(cmd, "w");
+    if (tf != NULL) {
+      fputs("return 6 * 7\n", tf);
+      fclose(tf);
+    }
+    mark = s.len;
+    send(&s, "dofile(\"pty-completion-ta\t");   /* the session runs in tmp */
+    EXPECT(&s, mark, "pty-completion-target.lua\"", "a file name inside a string");
+    send(&s, ")\r");
+    EXPECT(&s, mark, "42", "the completed file runs");
+
+    mark = s.len;
+    send(&s, "help \"dm.integrator\"\r");
+    EXPECT(&s, mark, "Options: method", "help shows the options");
+    EXPECT(&s, (size_t)(strstr(s.buf + mark, "Options: method") - s.buf), "dm> ", "prompt after help");
+    tap_ok(longest_line(s.buf, mark, s.len) <= 60, "help wrapped to the 60-column terminal (longest %d)",
+           (int)longest_line(s.buf, mark, s.len));
+    mark = s.len;
+    send(&s, "help\r");
+    EXPECT(&s, mark, " entries", "bare help at the prompt");
+    send(&s, "\x04");
+    finish(&s, &status);
+  }
+  /* bracketed paste needs a terminal that has it */
+  if (start_term(&s, state, "xterm", 80) != 0)
+    return tap_done();
+  EXPECT(&s, 0, "dm> ", "fifth session prompt (xterm)");
+  {
+    mark = s.len;
+    send(&s, "\x1b[200~local a = 2.5\nlocal b = 4\nprint(\"pasted\")\na * b\n\x1b[201~");
+    EXPECT(&s, mark, "pasted", "a bracketed paste runs at once, statement by statement");
+    EXPECT(&s, mark, "10.0", "and shows the value of its last expression");
+    mark = s.len;
+    send(&s, "b + 0.385\r");
+    EXPECT(&s, mark, "4.385", "the paste's locals stay defined");
+    mark = s.len;
+    send(&s, "c = 1; c + 1\r");
+    EXPECT(&s, mark, "\r2\r\n", "a = 1; a + 1 prints 2");
+    send(&s, "quit\r");
+    tap_ok(finish(&s, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0,
+           "bare quit leaves with status 0");
+  }
 
   /* ---- a second Ctrl-C during the same run quits ---- */
   if (start(&s, state) != 0)

@@ -26,7 +26,7 @@ local tr = dm.trajectory{
 }
 
 T.is(#tr, N, "#traj is the number of samples")
-T.is(tostring(tr), "<Trajectory 401 samples t=[0,20] Kepler (polar) (gauss s=2 h=0.05)>",
+T.is(tostring(tr), "<Trajectory 401 samples t=[0, 20] Kepler (polar) (gauss s=2 h=0.05)>",
      "tostring: samples, time span, system, method")
 T.is(table.concat(tr:names(), ","),
      "t,r,theta,p_r,p_theta,v_r,v_theta,energy,extra,momentum_theta",
@@ -100,8 +100,8 @@ T.ok(b:meta().system == "Kepler (polar)" and b:energy()[2] == E[101], "slices ke
 -- a plain data table: no coordinates
 local d = dm.trajectory{t = {0.5, 1.5}, columns = {x = {2.385, 1e-300}}}
 T.ok(#d == 2 and d:column("x")[2] == 1e-300 and #d.q == 0, "columns only, no coordinates")
-T.is(tostring(d), "<Trajectory 2 samples t=[0.5,1.5]>", "tostring without metadata")
-T.is(tostring(dm.trajectory{t = {3}}), "<Trajectory 1 sample t=[3,3]>", "one sample")
+T.is(tostring(d), "<Trajectory 2 samples t=[0.5, 1.5]>", "tostring without metadata")
+T.is(tostring(dm.trajectory{t = {3}}), "<Trajectory 1 sample t=[3, 3]>", "one sample")
 
 -- to-be-closed and collected trajectories
 do

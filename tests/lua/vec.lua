@@ -58,7 +58,15 @@ T.error_like(function() a[0] = 1 end, "vec index 0 out of range", "write out of 
 T.error_like(function() a.foo = 1 end, "cannot set field 'foo'", "field assignment")
 T.error_like(function() a[1] = "x" end, "bad argument #3 to 'newindex' %(number expected, got string%)", "non-number assignment")
 T.error_like(function() return a + dm.vec{1, 2} end, "vec %+ vec: lengths differ %(3 and 2%)", "length mismatch +")
-T.error_like(function() return a + 1 end, "no broadcasting", "vec + number")
+-- a number broadcasts over a vec, on either side
+local w = dm.vec{2.385, -1.5, 4}
+T.ok((w + 1.25) == dm.vec{3.635, -0.25, 5.25}, "vec + number")
+T.ok((1.25 + w) == dm.vec{3.635, -0.25, 5.25}, "number + vec")
+T.ok((w - 0.5) == dm.vec{2.385 - 0.5, -2, 3.5}, "vec - number")
+T.ok((0.5 - w) == dm.vec{0.5 - 2.385, 2, -3.5}, "number - vec")
+T.ok((3 * w) == dm.vec{3 * 2.385, -4.5, 12}, "number * vec")
+T.ok((w / 2) == dm.vec{2.385 / 2, -0.75, 2}, "vec / number")
+T.ok((1 / w) == dm.vec{1 / 2.385, 1 / -1.5, 0.25}, "number / vec")
 T.error_like(function() return a * "x" end, "vec %*: vec or number operands expected, got userdata and string", "vec * string")
 T.error_like(function() return a:dot{1, 2} end, "bad argument #1 to 'dot' %(vector of length 3 expected, got length 2%)", "dot length")
 T.error_like(function() return a:dot(42) end, "bad argument #1 to 'dot' %(vec or table of numbers expected, got number%)", "dot type")
