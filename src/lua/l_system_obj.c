@@ -453,6 +453,8 @@ static const dm_field system_fields[] = {
   {"cyclic", "sys.cyclic -> {name, ...}", "The coordinates that L does not depend on."},
   {"traced", "sys.traced -> boolean", "True for a system traced from a Lua L (false: built-in C)."},
   {"native", "sys.native -> boolean", "True when the traced derivatives run as native code (else the tape)."},
+  {"compiling", "sys.compiling -> boolean", "True while the native code is being compiled in the background."},
+  {"native_error", "sys.native_error -> string | nil", "Why the native code could not be built, or nil."},
   {"separable", "sys.separable -> boolean", "True when L = 1/2 v.M v - V(q) with a constant M."},
   {"mechanical", "sys.mechanical -> boolean", "True when L is quadratic in the velocities."},
   {"forced", "sys.forced -> boolean", "True when the system has a Lagrange-d'Alembert force."},

@@ -74,6 +74,22 @@ local docs = dm.docs()
 T.ok(docs["dm.system"].opts and docs["dm.routh"].opts and docs["integrator:run"].opts,
      "options documented for dm.system, dm.routh, integrator:run")
 
+-- every field an object's error message lists is documented (completion and
+-- help(obj) read the documentation)
+local function listed_fields(obj)
+  local ok, err = pcall(function() return obj.zz_no_such_field end)
+  return not ok and tostring(err):match("%(fields: ([^)]*)%)")
+end
+for what, obj in pairs{system = sys, integrator = I} do
+  local list, missing = listed_fields(obj), {}
+  T.ok(list, what .. ": the error for an unknown field lists the fields")
+  for f in (list or ""):gmatch("[%w_]+") do
+    if not docs[what .. "." .. f] then missing[#missing + 1] = f end
+  end
+  T.ok(#missing == 0, what .. ": every listed field is documented" ..
+       (#missing > 0 and (" (missing: " .. table.concat(missing, ", ") .. ")") or ""))
+end
+
 -- {== hints
 local function hint(msg, info) return H.hint(msg, info or {}) end
 T.is(hint("x: dm.integrator: unknown option metod (options: method, tableau, stages, h)"),
