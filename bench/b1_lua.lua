@@ -3,7 +3,7 @@
 -- integ:run with one sample at the end), in one run, side by side:
 --   Kepler e = 0.6, Stormer-Verlet (trapezoid) h = 0.01
 --   J2 Cartesian (J2 = 0.05), Gauss s = 2, h = 0.05
--- each on dm.builtin (hand-written C system; ratio 1), dm.systems traced to
+-- each on dm.systems.<name>{impl = "c"} (hand-written C system; ratio 1), dm.systems traced to
 -- a tape (native = "never") and to native code (native = "always").
 -- Median of BENCH_REPEAT (default 7) interleaved runs, steps calibrated to
 -- ~0.15 s per run.  Usage: dmech bench/b1_lua.lua
@@ -23,7 +23,7 @@ local function machine()
   print("# B1 through src/dmech (bench/b1_lua.lua): dm.system / dm.integrator / integ:run")
   print(("# machine: %s, %s; %s"):format(model, (io.popen("nproc"):read("l") or "?") .. " cores",
     _VERSION))
-  print(("# median of %d interleaved runs, each ~%.2f s CPU; ratios are to dm.builtin in this run"):format(R, TARGET))
+  print(("# median of %d interleaved runs, each ~%.2f s CPU; ratios are to the C implementation in this run"):format(R, TARGET))
 end
 
 local function median(t)
@@ -37,7 +37,7 @@ end
 local function make(which, kind)
   local sys
   if kind == "builtin" then
-    sys = which == "kepler" and dm.builtin.kepler{} or dm.builtin.j2{J2 = 0.05}
+    sys = which == "kepler" and dm.systems.kepler{impl = "c"} or dm.systems.j2{J2 = 0.05, impl = "c"}
   else
     dm.config.native = kind
     sys = which == "kepler" and dm.systems.kepler{} or dm.systems.j2{J2 = 0.05}
@@ -60,7 +60,7 @@ local function run(V, n)
 end
 
 local function bench(title, which)
-  local kinds = {{"builtin", "dm.builtin (hand-written C system)"},
+  local kinds = {{"builtin", "impl = \"c\" (hand-written C system)"},
                  {"never", "dm.systems traced, tape"},
                  {"always", "dm.systems traced, native"}}
   local Vs = {}

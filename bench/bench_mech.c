@@ -416,7 +416,7 @@ static const char script[] =
   "local s = {q = {2, 0, 0.3}, p = {0, 0.6, 0.1}}\n"
   "local g2 = {method = 'gauss', stages = 2, h = 0.05}\n"
   "header(('J2 satellite (Cartesian), Gauss s=2, h = 0.05, %d steps'):format(N))\n"
-  "local fb, bI = user(dm.builtin.j2{J2 = 0.05}, g2, s, N)\n"
+  "local fb, bI = user(dm.systems.j2{J2 = 0.05, impl = 'c'}, g2, s, N)\n"
   "measure({\n"
   "  {name = 'hand-written C Gauss-2 loop', f = function() return B.gauss2_j2(s.q, s.p, 0.05, N, 0.05) end},\n"
   "  {name = 'C API: built-in J2, dm_integrator_run', f = function() return B.capi('j2', 'gauss', 2, 0.05, s.q, s.p, N) end},\n"
@@ -438,7 +438,7 @@ static const char script[] =
   "measure({\n"
   "  {name = 'hand-written C leapfrog', f = function() return B.leapfrog(k.q, k.p, 0.01, M) end},\n"
   "  {name = 'C API: built-in Kepler, dm_integrator_run', f = function() return B.capi('kepler', 'trapezoid', 0, 0.01, k.q, k.p, M) end},\n"
-  "  {name = 'dmech, built-in C Kepler system', f = user(dm.builtin.kepler(), sv, k, M)},\n"
+  "  {name = 'dmech, built-in C Kepler system', f = user(dm.systems.kepler{impl = 'c'}, sv, k, M)},\n"
   "  {name = 'dmech, traced L, native code', f = user(kep('always'), sv, k, M), target = 1.3},\n"
   "  {name = 'dmech, traced L, tape', f = user(kep(false), sv, k, M), target = 4},\n"
   "}, M)\n";

@@ -2,27 +2,41 @@
 --
 -- Each entry is a function of an optional table of parameters (and a few
 -- options) returning a dm.system whose Lagrangian is written below in plain
--- Lua, so every one is also an example of dm.system.  The module returns an
--- installer that the C opener calls with the dm table being built; the
--- functions use dm only when called.
-return function(dm)
+-- Lua, so every one is also an example of dm.system.  Several entries also
+-- exist as hand-written C (the speed references): impl = "c" gives that
+-- implementation of the same system -- same Lagrangian, coordinates and
+-- parameters, no expressions.  The module returns an installer that the C
+-- opener calls with the dm table being built and the table of C
+-- constructors; the functions use dm only when called.
+return function(dm, C)
   local S = {}
+  C = C or {}
 
   -- Parameters in a fixed order from defaults, overridden by opts; the
-  -- option names in `extra` are returned separately.  Unknown keys raise.
+  -- option names in `extra` (and impl, which every entry takes) are
+  -- returned separately.  Unknown keys raise.
   local function params(fname, opts, defaults, extra)
     opts = opts or {}
     if type(opts) ~= "table" then
       error(("dm.systems.%s: table of parameters expected, got %s"):format(fname, type(opts)), 3)
     end
-    local known, list, ex = {}, {}, {}
+    extra = extra or {}
+    if opts.impl ~= nil and opts.impl ~= "traced" and not C[fname] then
+      local have = {}
+      for k in pairs(C) do have[#have + 1] = k end
+      table.sort(have)
+      error(("dm.systems.%s: no C implementation (impl = \"c\" exists for %s)"):format(fname,
+        table.concat(have, ", ")), 3)
+    end
+    local known, list, ex = {impl = true}, {}, {}
     for _, d in ipairs(defaults) do known[d[1]] = true end
-    for _, k in ipairs(extra or {}) do known[k] = true end
+    for _, k in ipairs(extra) do known[k] = true end
     for k in pairs(opts) do
       if not known[k] then
         local names = {}
         for _, d in ipairs(defaults) do names[#names + 1] = d[1] end
-        for _, e in ipairs(extra or {}) do names[#names + 1] = e end
+        for _, e in ipairs(extra) do names[#names + 1] = e end
+        names[#names + 1] = "impl"
         error(("dm.systems.%s: unknown parameter %s (parameters: %s)"):format(fname, tostring(k),
           table.concat(names, ", ")), 3)
       end
@@ -35,8 +49,22 @@ return function(dm)
       end
       list[#list + 1] = {d[1], v}
     end
-    for _, k in ipairs(extra or {}) do ex[k] = opts[k] end
+    for _, k in ipairs(extra) do ex[k] = opts[k] end
+    ex.impl = opts.impl
     return list, ex
+  end
+
+  -- The C implementation when opts.impl == "c" (nil for the traced one).
+  local function impl(fname, ex, list)
+    local which = ex.impl or "traced"
+    if which == "traced" then return nil end
+    if which ~= "c" then
+      error(("dm.systems.%s: impl must be \"traced\" or \"c\", got %s"):format(fname, tostring(which)), 3)
+    end
+    local t = {}
+    for _, d in ipairs(list) do t[d[1]] = d[2] end
+    for k, v in pairs(ex) do if k ~= "impl" then t[k] = v end end
+    return C[fname](t)
   end
 
   local function def(name, sig, doc, f)
@@ -46,39 +74,41 @@ return function(dm)
 
   local function sq(x) return x * x end
 
-  def("harmonic", "dm.systems.harmonic{omega=1, m=1} -> system",
+  def("harmonic", "dm.systems.harmonic{omega=1, m=1, impl=\"traced\"|\"c\"} -> system",
     "Harmonic oscillator L = m v^2/2 - m omega^2 x^2/2 (coordinate x): Gauss methods rotate (omega x, p/m) exactly by a modified angle, Stormer-Verlet is stable for h omega < 2.",
     function(o)
-      local p = params("harmonic", o, {{"m", 1}, {"omega", 1}})
-      return dm.system{name = "harmonic oscillator", coords = {"x"}, params = p,
+      local p, ex = params("harmonic", o, {{"m", 1}, {"omega", 1}})
+      return impl("harmonic", ex, p) or dm.system{name = "harmonic oscillator", coords = {"x"}, params = p,
         L = function(q, v, p) return 0.5 * p.m * (v.x^2 - p.omega^2 * q.x^2) end}
     end)
 
-  def("damped", "dm.systems.damped{omega=1, c=0.1, m=1} -> system",
+  def("damped", "dm.systems.damped{omega=1, c=0.1, m=1, impl=\"traced\"|\"c\"} -> system",
     "Damped oscillator: L = m v^2/2 - m omega^2 x^2/2 with the Lagrange-d'Alembert force F = -c v; for light damping the energy decays like E0 exp(-c t/m).",
     function(o)
-      local p = params("damped", o, {{"m", 1}, {"omega", 1}, {"c", 0.1}})
-      return dm.system{name = "damped oscillator", coords = {"x"}, params = p,
+      local p, ex = params("damped", o, {{"m", 1}, {"omega", 1}, {"c", 0.1}})
+      return impl("damped", ex, p) or dm.system{name = "damped oscillator", coords = {"x"}, params = p,
         L = function(q, v, p) return 0.5 * p.m * (v.x^2 - p.omega^2 * q.x^2) end,
         force = function(q, v, p) return {-p.c * v.x} end}
     end)
 
-  def("pendulum", "dm.systems.pendulum{g=9.81, l=1, m=1} -> system",
+  def("pendulum", "dm.systems.pendulum{g=9.81, l=1, m=1, impl=\"traced\"|\"c\"} -> system",
     "Planar pendulum, angle theta from the downward vertical: L = m l^2 thetadot^2/2 + m g l cos(theta).",
     function(o)
-      local p = params("pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
-      return dm.system{name = "pendulum", coords = {"theta"}, params = p,
+      local p, ex = params("pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
+      return impl("pendulum", ex, p) or dm.system{name = "pendulum", coords = {"theta"}, params = p,
         L = function(q, v, p)
           return 0.5 * p.m * p.l^2 * v.theta^2 + p.m * p.g * p.l * dm.cos(q.theta)
         end}
     end)
 
-  def("kepler", "dm.systems.kepler{mu=1, dim=2} -> system",
+  def("kepler", "dm.systems.kepler{mu=1, dim=2, impl=\"traced\"|\"c\"} -> system",
     "Kepler problem in Cartesian coordinates (x, y[, z]): L = |v|^2/2 + mu/|q|; energy, angular momentum and the Runge-Lenz vector are conserved (e = 0.6: q = (0.4, 0), p = (0, 2), period 2 pi).",
     function(o)
       local p, ex = params("kepler", o, {{"mu", 1}}, {"dim"})
       local dim = ex.dim or 2
       if dim ~= 2 and dim ~= 3 then error("dm.systems.kepler: dim must be 2 or 3", 2) end
+      local c = impl("kepler", ex, p)
+      if c then return c end
       local coords = dim == 2 and {"x", "y"} or {"x", "y", "z"}
       return dm.system{name = "Kepler (Cartesian)", coords = coords, params = p,
         L = function(q, v, p)
@@ -105,11 +135,11 @@ return function(dm)
     return -1 / R + J2 / R^3 * (1.5 * z^2 / R2 - 0.5)
   end
 
-  def("j2", "dm.systems.j2{J2=0.05} -> system",
+  def("j2", "dm.systems.j2{J2=0.05, impl=\"traced\"|\"c\"} -> system",
     "J2 satellite in Cartesian (x, y, z), non-dimensional (Earth radius 1): L = |v|^2/2 - V, V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (thesis §2.9, with the sign of the printed Kepler term corrected); the z angular momentum is conserved.",
     function(o)
-      local p = params("j2", o, {{"J2", 0.05}})
-      return dm.system{name = "J2 satellite (Cartesian)", coords = {"x", "y", "z"}, params = p,
+      local p, ex = params("j2", o, {{"J2", 0.05}})
+      return impl("j2", ex, p) or dm.system{name = "J2 satellite (Cartesian)", coords = {"x", "y", "z"}, params = p,
         L = function(q, v, p)
           return 0.5 * (v.x^2 + v.y^2 + v.z^2) - j2_potential(q.x^2 + q.y^2 + q.z^2, q.z, p.J2)
         end}
@@ -136,18 +166,18 @@ return function(dm)
         end}
     end)
 
-  def("spherical_pendulum", "dm.systems.spherical_pendulum{g=9.81, l=1, m=1} -> system",
+  def("spherical_pendulum", "dm.systems.spherical_pendulum{g=9.81, l=1, m=1, impl=\"traced\"|\"c\"} -> system",
     "Spherical pendulum in spherical coordinates (theta from the downward vertical, phi azimuth): L = m l^2 (thetadot^2 + sin^2(theta) phidot^2)/2 + m g l cos(theta); phi is cyclic (the vertical angular momentum m l^2 sin^2(theta) phidot).",
     function(o)
-      local p = params("spherical_pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
-      return dm.system{name = "spherical pendulum", coords = {"theta", "phi"}, params = p,
+      local p, ex = params("spherical_pendulum", o, {{"g", 9.81}, {"l", 1}, {"m", 1}})
+      return impl("spherical_pendulum", ex, p) or dm.system{name = "spherical pendulum", coords = {"theta", "phi"}, params = p,
         L = function(q, v, p)
           return 0.5 * p.m * p.l^2 * (v.theta^2 + dm.sin(q.theta)^2 * v.phi^2)
             + p.m * p.g * p.l * dm.cos(q.theta)
         end}
     end)
 
-  def("spherical_pendulum_r3", "dm.systems.spherical_pendulum_r3{g=9.81, l=1, m=1, form=\"squared\"} -> system",
+  def("spherical_pendulum_r3", "dm.systems.spherical_pendulum_r3{g=9.81, l=1, m=1, form=\"squared\", impl=\"traced\"|\"c\"} -> system",
     "Spherical pendulum in R^3 (x, y, z) with the holonomic constraint |q|^2 - l^2 = 0 (form=\"norm\": |q| - l = 0): L = m |v|^2/2 - m g z; integrated with Lagrange multipliers (RATTLE, or multipliers at every stage).",
     function(o)
       local p, ex = params("spherical_pendulum_r3", o, {{"g", 9.81}, {"l", 1}, {"m", 1}}, {"form"})
@@ -155,6 +185,8 @@ return function(dm)
       if form ~= "squared" and form ~= "norm" then
         error("dm.systems.spherical_pendulum_r3: form must be \"squared\" or \"norm\"", 2)
       end
+      local c = impl("spherical_pendulum_r3", ex, p)
+      if c then return c end
       return dm.system{name = "spherical pendulum (R3)", coords = {"x", "y", "z"}, params = p,
         L = function(q, v, p)
           return 0.5 * p.m * (v.x^2 + v.y^2 + v.z^2) - p.m * p.g * q.z

@@ -11,13 +11,35 @@
 typedef struct bdata {
   double par[4];
   double mass[9];
+  size_t n;
   int form;
+  double (*mscale)(const double *par);   /* mass = mscale(par) Id; NULL: unit */
 } bdata;
 
 static void bfree(dm_system *s)
 {
   free(s->data);
 }
+
+/* The constant mass matrix from the current parameters. */
+static int brefresh(dm_system *s, dm_err *e)
+{
+  bdata *d = s->data;
+  size_t i;
+  double m;
+  (void)e;
+  if (d == NULL || d->mscale == NULL)
+    return DM_OK;
+  m = d->mscale(d->par);
+  for (i = 0; i < d->n; i++)
+    d->mass[i * d->n + i] = m;
+  return DM_OK;
+}
+
+/* scalar masses of the systems with a mass parameter */
+static double mass_m0(const double *par) { return par[0]; }              /* m first */
+static double mass_m2(const double *par) { return par[2]; }              /* g, l, m */
+static double mass_ml2(const double *par) { return par[2] * par[1] * par[1]; }
 
 /* Common set-up: n coordinates, unit mass, parameter values. */
 static int setup(dm_system *s, const char *name, size_t n, size_t m, const char *const *coords,
@@ -45,7 +67,22 @@ static int setup(dm_system *s, const char *name, size_t n, size_t m, const char 
   s->lagrangian = lag;
   s->data = d;
   s->free_data = bfree;
+  s->refresh = brefresh;
+  d->n = n;
   return DM_OK;
+}
+
+/* setup, then a mass that follows a parameter */
+static int setup_m(dm_system *s, const char *name, size_t n, size_t m, const char *const *coords,
+                   const char *const *params, size_t npar, const double *par, unsigned flags,
+                   dm_lag_fn lag, double (*mscale)(const double *), dm_err *e)
+{
+  int st = setup(s, name, n, m, coords, params, npar, par, flags, lag, e);
+  if (st == DM_OK) {
+    ((bdata *)s->data)->mscale = mscale;
+    brefresh(s, NULL);
+  }
+  return st;
 }
 
 /* T = |v|^2 / 2 (only when L is asked for), Lv = v, Lvv = I, Lvq = 0. */
@@ -72,37 +109,55 @@ static inline void kinetic(size_t n, const double *v, unsigned what, dm_lag_out 
       o->Lvq[i] = 0.0;
 }
 
+/* The same with the mass M Id: T = M |v|^2 / 2, Lv = M v, Lvv = M Id. */
+static inline void kinetic_m(size_t n, double M, const double *v, unsigned what, dm_lag_out *o,
+                             double *T)
+{
+  size_t i;
+  kinetic(n, v, what, o, T);
+  if (what & DM_LAG_L)
+    *T *= M;
+  if (what & DM_LAG_V)
+    for (i = 0; i < n; i++)
+      o->Lv[i] *= M;
+  if (what & DM_LAG_VV)
+    for (i = 0; i < n; i++)
+      o->Lvv[i * n + i] = M;
+}
+
 /* {==== harmonic oscillator, pendulum, damped oscillator ================= */
 
+/* par: m, omega */
 static int harmonic_lag(void *data, const double *q, const double *v, const double *par,
                         unsigned what, dm_lag_out *o, void *work)
 {
-  double w2 = par[0] * par[0], T = 0.0;
+  double m = par[0], k = m * par[1] * par[1], T = 0.0;
   (void)data;
   (void)work;
-  kinetic(1, v, what, o, &T);
+  kinetic_m(1, m, v, what, o, &T);
   if (what & DM_LAG_L)
-    o->L = T - 0.5 * w2 * q[0] * q[0];
+    o->L = T - 0.5 * k * q[0] * q[0];
   if (what & DM_LAG_Q)
-    o->Lq[0] = -w2 * q[0];
+    o->Lq[0] = -k * q[0];
   if (what & DM_LAG_QQ)
-    o->Lqq[0] = -w2;
+    o->Lqq[0] = -k;
   return 0;
 }
 
+/* par: g, l, m */
 static int pendulum_lag(void *data, const double *q, const double *v, const double *par,
                         unsigned what, dm_lag_out *o, void *work)
 {
-  double T = 0.0;
+  double g = par[0], l = par[1], m = par[2], mgl = m * g * l, T = 0.0;
   (void)data;
   (void)work;
-  kinetic(1, v, what, o, &T);
+  kinetic_m(1, m * l * l, v, what, o, &T);
   if (what & DM_LAG_L)
-    o->L = T + par[0] * cos(q[0]);
+    o->L = T + mgl * cos(q[0]);
   if (what & DM_LAG_Q)
-    o->Lq[0] = -par[0] * sin(q[0]);
+    o->Lq[0] = -mgl * sin(q[0]);
   if (what & DM_LAG_QQ)
-    o->Lqq[0] = -par[0] * cos(q[0]);
+    o->Lqq[0] = -mgl * cos(q[0]);
   return 0;
 }
 
@@ -112,37 +167,40 @@ static int damping_force(void *data, const double *q, const double *v, const dou
   (void)data;
   (void)q;
   (void)work;
-  if (what & DM_FORCE_F)
-    F[0] = -par[1] * v[0];
+  if (what & DM_FORCE_F)            /* par: m, omega, c */
+    F[0] = -par[2] * v[0];
   if (what & DM_FORCE_Q)
     Fq[0] = 0.0;
   if (what & DM_FORCE_V)
-    Fv[0] = -par[1];
+    Fv[0] = -par[2];
   return 0;
 }
 
-static const char *const q1names[] = {"q"};
+static const char *const xname[] = {"x"};
 
-int dm_builtin_harmonic(dm_system *s, double omega, dm_err *e)
+int dm_builtin_harmonic(dm_system *s, double m, double omega, dm_err *e)
 {
-  static const char *const pn[] = {"omega"};
-  return setup(s, "harmonic oscillator", 1, 0, q1names, pn, 1, &omega,
-               DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, harmonic_lag, e);
+  static const char *const pn[] = {"m", "omega"};
+  double par[2] = {m, omega};
+  return setup_m(s, "harmonic oscillator", 1, 0, xname, pn, 2, par,
+                 DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, harmonic_lag, mass_m0, e);
 }
 
-int dm_builtin_pendulum(dm_system *s, double k, dm_err *e)
+int dm_builtin_pendulum(dm_system *s, double g, double l, double m, dm_err *e)
 {
-  static const char *const pn[] = {"k"};
-  return setup(s, "pendulum", 1, 0, q1names, pn, 1, &k, DM_SYS_SEPARABLE | DM_SYS_MECHANICAL,
-               pendulum_lag, e);
+  static const char *const cn[] = {"theta"};
+  static const char *const pn[] = {"g", "l", "m"};
+  double par[3] = {g, l, m};
+  return setup_m(s, "pendulum", 1, 0, cn, pn, 3, par, DM_SYS_SEPARABLE | DM_SYS_MECHANICAL,
+                 pendulum_lag, mass_ml2, e);
 }
 
-int dm_builtin_damped_oscillator(dm_system *s, double omega, double c, dm_err *e)
+int dm_builtin_damped_oscillator(dm_system *s, double m, double omega, double c, dm_err *e)
 {
-  static const char *const pn[] = {"omega", "c"};
-  double par[2] = {omega, c};
-  int st = setup(s, "damped oscillator", 1, 0, q1names, pn, 2, par,
-                 DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, harmonic_lag, e);
+  static const char *const pn[] = {"m", "omega", "c"};
+  double par[3] = {m, omega, c};
+  int st = setup_m(s, "damped oscillator", 1, 0, xname, pn, 3, par,
+                   DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, harmonic_lag, mass_m0, e);
   if (st == DM_OK)
     s->force = damping_force;
   return st;
@@ -203,7 +261,7 @@ int dm_builtin_kepler(dm_system *s, int dim, double mu, dm_err *e)
     memset(s, 0, sizeof *s);
     return dm_err_set(e, DM_EINVAL, "kepler: dimension must be 2 or 3 (got %d)", dim);
   }
-  return setup(s, dim == 2 ? "Kepler (2-D Cartesian)" : "Kepler (3-D Cartesian)", (size_t)dim, 0,
+  return setup(s, "Kepler (Cartesian)", (size_t)dim, 0,
                xyz, pn, 1, &mu, DM_SYS_SEPARABLE | DM_SYS_MECHANICAL,
                dim == 2 ? kepler2_lag : kepler3_lag, e);
 }
@@ -266,15 +324,15 @@ int dm_builtin_j2(dm_system *s, double J2, dm_err *e)
 static int sph_r3_lag(void *data, const double *q, const double *v, const double *par,
                       unsigned what, dm_lag_out *o, void *work)
 {
-  double T = 0.0;
+  double T = 0.0, mg = par[2] * par[0];          /* par: g, l, m */
   (void)data;
   (void)work;
-  kinetic(3, v, what, o, &T);
+  kinetic_m(3, par[2], v, what, o, &T);
   if (what & DM_LAG_L)
-    o->L = T - par[0] * q[2];
+    o->L = T - mg * q[2];
   if (what & DM_LAG_Q) {
     o->Lq[0] = o->Lq[1] = 0.0;
-    o->Lq[2] = -par[0];
+    o->Lq[2] = -mg;
   }
   if (what & DM_LAG_QQ)
     memset(o->Lqq, 0, 9 * sizeof(double));
@@ -313,17 +371,18 @@ static int sph_r3_constr(void *data, const double *q, const double *par, unsigne
   return 0;
 }
 
-int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, int form, dm_err *e)
+int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, double m, int form,
+                                     dm_err *e)
 {
-  static const char *const pn[] = {"g", "l"};
-  double par[2] = {g, l};
+  static const char *const pn[] = {"g", "l", "m"};
+  double par[3] = {g, l, m};
   int st;
   if (form != 0 && form != 1) {
     memset(s, 0, sizeof *s);
     return dm_err_set(e, DM_EINVAL, "spherical pendulum: constraint form must be 0 or 1");
   }
-  st = setup(s, "spherical pendulum (constrained in R3)", 3, 1, xyz, pn, 2, par,
-             DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, sph_r3_lag, e);
+  st = setup_m(s, "spherical pendulum (R3)", 3, 1, xyz, pn, 3, par,
+               DM_SYS_SEPARABLE | DM_SYS_MECHANICAL, sph_r3_lag, mass_m2, e);
   if (st == DM_OK) {
     ((bdata *)s->data)->form = form;
     s->constraints = sph_r3_constr;
@@ -334,7 +393,7 @@ int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, int form,
 static int sph_lag(void *data, const double *q, const double *v, const double *par,
                    unsigned what, dm_lag_out *o, void *work)
 {
-  double g = par[0], l = par[1], l2 = l * l, st = sin(q[0]), ct = cos(q[0]);
+  double g = par[0] * par[2], l = par[1], l2 = par[2] * l * l, st = sin(q[0]), ct = cos(q[0]);
   (void)data;
   (void)work;
   if (what & DM_LAG_L)
@@ -363,11 +422,11 @@ static int sph_lag(void *data, const double *q, const double *v, const double *p
   return 0;
 }
 
-int dm_builtin_spherical_pendulum(dm_system *s, double g, double l, dm_err *e)
+int dm_builtin_spherical_pendulum(dm_system *s, double g, double l, double m, dm_err *e)
 {
   static const char *const cn[] = {"theta", "phi"};
-  static const char *const pn[] = {"g", "l"};
-  double par[2] = {g, l};
-  return setup(s, "spherical pendulum (spherical coordinates)", 2, 0, cn, pn, 2, par,
+  static const char *const pn[] = {"g", "l", "m"};
+  double par[3] = {g, l, m};
+  return setup(s, "spherical pendulum", 2, 0, cn, pn, 3, par,
                DM_SYS_MECHANICAL, sph_lag, e);
 }

@@ -14,11 +14,17 @@
 #include "core/status.h"
 #include "core/system.h"
 
-/* L = 1/2 v^2 - 1/2 omega^2 q^2 (n = 1; par: omega). Separable. */
-int dm_builtin_harmonic(dm_system *s, double omega, dm_err *e);
+/* The systems of the catalogue (dm.systems, lua/dmech/systems.lua) written
+ * in C: the same Lagrangians, coordinate names, parameter names and order,
+ * so that dm.systems.<name>{impl = "c"} is the same system.  A mass that
+ * depends on a parameter is refreshed by s->refresh after a change. */
 
-/* L = 1/2 v^2 + k cos q (n = 1; par: k = g/l; k = 1 in doc/integrators.md §12). Separable. */
-int dm_builtin_pendulum(dm_system *s, double k, dm_err *e);
+/* L = m v^2/2 - m omega^2 x^2/2 (coordinate x; par: m, omega). Separable. */
+int dm_builtin_harmonic(dm_system *s, double m, double omega, dm_err *e);
+
+/* L = m l^2 v^2/2 + m g l cos(theta) (coordinate theta; par: g, l, m;
+ * g = l = m = 1 in doc/integrators.md §12). Separable. */
+int dm_builtin_pendulum(dm_system *s, double g, double l, double m, dm_err *e);
 
 /* Kepler problem in dim = 2 or 3 Cartesian coordinates:
  * L = 1/2 |v|^2 + mu / |q| (par: mu). Separable. */
@@ -30,19 +36,21 @@ int dm_builtin_kepler(dm_system *s, int dim, double mu, dm_err *e);
  * (par: J2). Separable. */
 int dm_builtin_j2(dm_system *s, double J2, dm_err *e);
 
-/* Damped oscillator: L = 1/2 v^2 - 1/2 omega^2 q^2 with the generalized force
- * F = -c v (par: omega, c). Energy decays like exp(-c t) for light damping. */
-int dm_builtin_damped_oscillator(dm_system *s, double omega, double c, dm_err *e);
+/* Damped oscillator: L = m v^2/2 - m omega^2 x^2/2 with the generalized
+ * force F = -c v (par: m, omega, c). Energy decays like exp(-c t/m) for
+ * light damping. */
+int dm_builtin_damped_oscillator(dm_system *s, double m, double omega, double c, dm_err *e);
 
 /* Spherical pendulum in R^3 with one holonomic constraint:
- *   L = 1/2 |v|^2 - g q3,   form 0: g(q) = |q|^2 - l^2,   form 1: g(q) = |q| - l
- * (par: g, l). Separable. */
-int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, int form, dm_err *e);
+ *   L = m |v|^2/2 - m g z,   form 0: g(q) = |q|^2 - l^2,   form 1: g(q) = |q| - l
+ * (par: g, l, m). Separable. */
+int dm_builtin_spherical_pendulum_r3(dm_system *s, double g, double l, double m, int form,
+                                     dm_err *e);
 
 /* Spherical pendulum in spherical coordinates (theta from the downward
  * vertical, phi azimuth), q = l (sin th cos ph, sin th sin ph, -cos th):
- *   L = 1/2 l^2 (thdot^2 + sin^2 th phdot^2) + g l cos th   (par: g, l).
+ *   L = m l^2 (thdot^2 + sin^2 th phdot^2)/2 + m g l cos th   (par: g, l, m).
  * Mechanical (not separable); phi is cyclic. */
-int dm_builtin_spherical_pendulum(dm_system *s, double g, double l, dm_err *e);
+int dm_builtin_spherical_pendulum(dm_system *s, double g, double l, double m, dm_err *e);
 
 #endif

@@ -32,6 +32,7 @@
 #include <stddef.h>
 
 #include "core/sparse.h"
+#include "core/status.h"
 
 /* Which outputs a Lagrangian evaluation must fill (bit mask). */
 enum dm_lag_what {
@@ -129,6 +130,9 @@ typedef struct dm_system {
    * Drivers call it between steps, never during one, from the thread that
    * uses the system.  Returns 1 while more is on its way, else 0. */
   int (*update)(const struct dm_system *);
+  /* Bring what the filler derived from the parameters (a constant mass
+   * matrix) up to date after par changed; NULL: nothing to do. */
+  int (*refresh)(struct dm_system *, dm_err *);
 } dm_system;
 
 /* Release what the system's filler owns (calls free_data) and zero *s.

@@ -157,7 +157,7 @@ void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x)
   dm_err e;
   ls->sys.par[i] = x;
   ls->gen++;
-  if (ls->traced && dm_lagrangian_refresh(&ls->sys, &e) != DM_OK)
+  if (ls->sys.refresh && ls->sys.refresh(&ls->sys, &e) != DM_OK)
     dm_lua_fail(L, "parameter", e.status, &e);
 }
 
@@ -463,6 +463,7 @@ static int l_system(lua_State *L)
   if ((s = dm_lagrangian_compile(dm_lua_exprctx(L), &sp, &ls->sys, &e)) != DM_OK)
     return dm_lua_fail(L, "dm.system", s, &e);
   ls->traced = 1;
+  ls->sys.refresh = dm_lagrangian_refresh;     /* its separable mass follows the parameters */
   if (dm_lagrangian_stats_get(&ls->sys, &st) == DM_OK)
     ls->native = st.native_all;
   detect_cyclic(L, ls);

@@ -326,6 +326,7 @@ int dm_routh_compile_nodes(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
   red->sys.constraints = red->rsys.constraints ? constr_forward : NULL;
   red->sys.data = red;
   red->sys.free_data = NULL;
+  red->sys.refresh = dm_routh_sys_refresh;
   red->nscratch = 8 * red->n + 4 * red->n * red->n + ninfo + red->nwork + 2 * red->np
                   + red->fsys.work_size / sizeof(double) + 1;
   red->scratch = calloc(red->nscratch, sizeof(double));
@@ -418,6 +419,17 @@ int dm_routh_set_mu(dm_routh *red, const double *mu, dm_err *e)
   for (a = 0; a < red->r; a++)
     red->par[red->npar + a] = mu[a];
   refresh(red);
+  return DM_OK;
+}
+
+/* The public reduced system's refresh hook: a parameter (or mu) changed
+ * through its par (shared by every system of the reduction). */
+int dm_routh_sys_refresh(dm_system *sys, dm_err *e)
+{
+  dm_routh *red;
+  (void)e;
+  if (dm_routh_of_system(sys, &red))
+    refresh(red);
   return DM_OK;
 }
 

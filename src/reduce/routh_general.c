@@ -239,6 +239,7 @@ int dm_routh_general_setup(dm_routh *red, dm_expr_ctx *ctx, const dm_routh_spec 
   red->sys = red->csys;
   red->sys.name = red->name;
   red->sys.lagrangian = dm_routh_lag_forward;
+  red->sys.refresh = dm_routh_sys_refresh;
   red->nscratch = 8 * red->n + 4 * red->n * red->n + red->np + 8 * s
                   + dm_routh_general_work(red) / sizeof(double) + 1;
   red->scratch = calloc(red->nscratch, sizeof(double));

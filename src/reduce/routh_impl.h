@@ -120,6 +120,8 @@ int dm_routh_general_thetadot(const dm_routh *red, const double *x, const double
                               const double *par, double *u, void *work);
 int dm_routh_general_velocity(dm_routh *red, const double *x, const double *px, double *xd,
                               dm_err *e);
+/* refresh hook of the public reduced system (par changed through it) */
+int dm_routh_sys_refresh(dm_system *sys, dm_err *e);
 int dm_routh_lag_forward(void *data, const double *q, const double *v, const double *par,
                          unsigned what, dm_lag_out *out, void *work);
 

@@ -81,13 +81,13 @@ int main(void)
   double L, d;
   int form;
 
-  dm_builtin_harmonic(&s, 2.385, NULL);
+  dm_builtin_harmonic(&s, 1.0, 2.385, NULL);
   tap_ok(check_lag(&s, q3, v3) < 1e-8 && s.n == 1 && (s.flags & DM_SYS_SEPARABLE) && s.mass[0] == 1.0,
          "harmonic oscillator derivatives (%.2g)", check_lag(&s, q3, v3));
   dm_system_release(&s);
   tap_ok(s.lagrangian == NULL && s.data == NULL, "dm_system_release zeroes the system");
 
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   tap_ok(check_lag(&s, q3, v3) < 1e-8, "pendulum derivatives (%.2g)", check_lag(&s, q3, v3));
   lag(&s, q3, v3, DM_LAG_L, &L, NULL, NULL, NULL, NULL, NULL);
   tap_near(L, 0.045 + cos(1.1), 1e-15, "pendulum L = v^2/2 + cos q");
@@ -124,7 +124,7 @@ int main(void)
   }
   dm_system_release(&s);
 
-  dm_builtin_damped_oscillator(&s, 2.385, 0.1, NULL);
+  dm_builtin_damped_oscillator(&s, 1.0, 2.385, 0.1, NULL);
   {
     double F, Fq, Fv;
     s.force(s.data, q3, v3, s.par, DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V, &F, &Fq, &Fv, NULL);
@@ -134,15 +134,15 @@ int main(void)
   dm_system_release(&s);
 
   for (form = 0; form <= 1; form++) {
-    dm_builtin_spherical_pendulum_r3(&s, 9.81, 1.3, form, NULL);
+    dm_builtin_spherical_pendulum_r3(&s, 9.81, 1.3, 1.0, form, NULL);
     d = check_constr(&s, q3);
     tap_ok(check_lag(&s, q3, v3) < 1e-8 && d < 1e-8 && s.m == 1,
            "spherical pendulum in R3, g form %d: derivatives, constraint gradient and Hessian (%.2g)", form, d);
     dm_system_release(&s);
   }
-  tap_is_int(dm_builtin_spherical_pendulum_r3(&s, 9.81, 1.3, 2, &e), DM_EINVAL, "constraint form 2 rejected");
+  tap_is_int(dm_builtin_spherical_pendulum_r3(&s, 9.81, 1.3, 1.0, 2, &e), DM_EINVAL, "constraint form 2 rejected");
 
-  dm_builtin_spherical_pendulum(&s, 9.81, 1.3, NULL);
+  dm_builtin_spherical_pendulum(&s, 9.81, 1.3, 1.0, NULL);
   tap_ok(check_lag(&s, q3, v3) < 1e-8 && (s.flags & DM_SYS_MECHANICAL) && !(s.flags & DM_SYS_SEPARABLE),
          "spherical pendulum in angles: derivatives (%.2g), mechanical, not separable", check_lag(&s, q3, v3));
   dm_system_release(&s);

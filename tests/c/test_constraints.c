@@ -33,7 +33,7 @@ static void reference(double T, double *q, double *v)
   dm_integ_opts o;
   dm_integrator *I = NULL;
   double x[2] = {TH0, PH0}, p[2], vv[2] = {THD0, PHD0};
-  dm_builtin_spherical_pendulum(&s, G, L, NULL);
+  dm_builtin_spherical_pendulum(&s, G, L, 1.0, NULL);
   dm_integ_opts_init(&o);
   o.stages = 6;
   dm_integrator_new(&s, "gauss", &o, &I, NULL);
@@ -93,7 +93,7 @@ static void manifold_and_order(void)
     double q[3], p[3], gmax = 0, tmax = 0, E0, Emax = 0, h[4], err[4], ord, dev = NAN;
     char buf[96];
     int k, j, st = DM_OK;
-    dm_builtin_spherical_pendulum_r3(&s, G, L, cm[i].form, NULL);
+    dm_builtin_spherical_pendulum_r3(&s, G, L, 1.0, cm[i].form, NULL);
     I = make(&s, &cm[i]);
     to_cart(TH0, PH0, THD0, PHD0, q, p);
     E0 = 0.5 * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) + G * q[2];
@@ -140,7 +140,7 @@ static void rattle_paths(void)
   dm_integrator *A, *B;
   double qa[3], pa[3], qb[3], pb[3], d = 0;
   int k, j;
-  dm_builtin_spherical_pendulum_r3(&s, G, L, 0, NULL);
+  dm_builtin_spherical_pendulum_r3(&s, G, L, 1.0, 0, NULL);
   A = make(&s, &e1);
   B = make(&s, &e0);
   to_cart(TH0, PH0, THD0, PHD0, qa, pa);
@@ -166,7 +166,7 @@ static void errors(void)
   dm_err e;
   double q[3], p[3], D[36], d;
   int st;
-  dm_builtin_spherical_pendulum_r3(&s, G, L, 0, NULL);
+  dm_builtin_spherical_pendulum_r3(&s, G, L, 1.0, 0, NULL);
   dm_integ_opts_init(&o);
   o.stages = 2;
   tap_is_int(dm_integrator_new(&s, "gauss", &o, &I, &e), DM_EUNSUP, "gauss s=2 with constraints: unsupported");

@@ -117,7 +117,7 @@ static void errors(void)
   tap_ok(st == DM_ENOCONV && strstr(e.msg, "did not converge in 1 iterations (update"),
          "maxiter = 1: %s", e.msg);
   dm_galerkin_free(g);
-  dm_builtin_spherical_pendulum_r3(&c, 9.81, 1.0, 0, NULL);
+  dm_builtin_spherical_pendulum_r3(&c, 9.81, 1.0, 1.0, 0, NULL);
   st = dm_galerkin_alloc(&c, t, 1e-15, 50, &g, &e);
   tap_ok(st == DM_EINVAL && g == NULL && strstr(e.msg, "unconstrained"), "constraints: %s", e.msg);
   ts_relativistic(&r);
@@ -160,7 +160,7 @@ int main(void)
   dm_gsl_init();
   dm_builtin_kepler(&kep, 2, 1.0, NULL);
   dm_builtin_j2(&j2, 0.05, NULL);
-  dm_builtin_damped_oscillator(&damp, 2.385, 0.3, NULL);
+  dm_builtin_damped_oscillator(&damp, 1.0, 2.385, 0.3, NULL);
   inverts_step("Kepler", &kep, "gauss", 2, kq0, kp0, 0.05);
   inverts_step("Kepler", &kep, "lobatto", 3, kq0, kp0, 0.05);
   inverts_step("J2", &j2, "gauss", 3, jq0, jp0, 0.05);

@@ -42,7 +42,7 @@ static void orders(void)
   };
   dm_system s;
   size_t i;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     dm_integ_opts o;
     double err[5], ord = NAN, q0 = 1.0, p0 = 0.5;
@@ -115,7 +115,7 @@ static void structure(void)
     double h[4] = {0.05, 0.025, 0.0125, 0.00625}, err[4], ord = NAN, q[2] = {1.2, 0.3}, p[2] = {0.4, 2.9};
     double d = NAN;
     dm_integrator *I = NULL;
-    dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, NULL);
+    dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, 1.0, NULL);
     dm_integ_opts_init(&o);
     dm_integrator_order_estimate(&sph, "composition", &o, q, p, 2.0, h, 4, NULL, NULL, err, &ord, NULL);
     dm_integrator_new(&sph, "composition", &o, &I, NULL);
@@ -133,7 +133,7 @@ static void errors(void)
   dm_integ_opts o;
   dm_integrator *I = (dm_integrator *)1;
   dm_err e;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   dm_integ_opts_init(&o);
   strcpy(o.scheme, "yoshida5");
   tap_is_int(dm_integrator_new(&s, "composition", &o, &I, &e), DM_ENOTFOUND, "unknown scheme rejected");

@@ -45,7 +45,7 @@ static void pendulum_one_step(void)
   };
   dm_system s;
   size_t i;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   for (i = 0; i < sizeof ref / sizeof ref[0]; i++) {
     dm_integrator *I = make(&s, ref[i].m, ref[i].s, ref[i].expl);
     double q = 1.0, p = 0.5;
@@ -77,7 +77,7 @@ static void pendulum_orders(void)
   const double qx = 0.29104535735144390609, px = -1.0417697671437177188;
   dm_system s;
   size_t i, j;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     dm_integ_opts o;
     double h[5], err[5], ord = NAN, q0 = 1.0, p0 = 0.5;
@@ -115,7 +115,7 @@ static void pendulum_analytic(void)
   gsl_sf_elljac_e(10.0, 0.25, &sn, &cn, &dn);
   tap_ok(fabs(2 * asin(0.5 * sn) - qx) < 1e-13 && fabs(cn - px) < 1e-13,
          "analytic pendulum: reference q(10), p(10) from GSL elljac (%.2g, %.2g)", 2 * asin(0.5 * sn) - qx, cn - px);
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   for (i = 0; i < sizeof c / sizeof c[0]; i++) {
     dm_integrator *I = make(&s, c[i].m, c[i].s, 1);
     double q = 0.0, p = 1.0;
@@ -138,7 +138,7 @@ static void harmonic_phase(void)
   const double im[4] = {0, z / 2, z / 2, z / 2 - z * z * z / 120};
   dm_system s;
   int sg;
-  dm_builtin_harmonic(&s, w, NULL);
+  dm_builtin_harmonic(&s, 1.0, w, NULL);
   for (sg = 1; sg <= 3; sg++) {
     dm_integrator *I = make(&s, "gauss", sg, 1);
     double q = 0.7, p = -0.31, th = 2.0 * atan2(im[sg], re[sg]);
@@ -205,7 +205,7 @@ static void defects(void)
   dm_system kep, sph;
   size_t i;
   dm_builtin_kepler(&kep, 2, 1.0, NULL);
-  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, NULL);
+  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, 1.0, NULL);
   for (i = 0; i < sizeof ms / sizeof ms[0]; i++) {
     dm_integrator *I = make(&kep, ms[i].m, ms[i].s, ms[i].expl);
     dm_integrator *J = make(&sph, ms[i].m, ms[i].s, ms[i].expl);
@@ -266,7 +266,7 @@ static void del_view(void)
   dm_system_release(&kep);
 
   /* discrete momentum along the cyclic phi of the spherical pendulum */
-  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, NULL);
+  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, 1.0, NULL);
   {
     dm_integrator *I = make(&sph, "gauss", 2, 1);
     const double xi[2] = {0.0, 1.0};
@@ -297,7 +297,7 @@ static void nonseparable_and_forced(void)
   const double wd = sqrt(w * w - c * c / 4), T = 10.0;
   double qx, vx, A, B, ex;
   int s;
-  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, NULL);
+  dm_builtin_spherical_pendulum(&sph, 9.81, 1.3, 1.0, NULL);
   dm_integ_opts_init(&o);
   o.stages = 2;
   {
@@ -307,7 +307,7 @@ static void nonseparable_and_forced(void)
   }
   dm_system_release(&sph);
 
-  dm_builtin_damped_oscillator(&dmp, w, c, NULL);
+  dm_builtin_damped_oscillator(&dmp, 1.0, w, c, NULL);
   A = q0;
   B = (v0 + 0.5 * c * q0) / wd;
   ex = exp(-0.5 * c * T);

@@ -27,7 +27,7 @@ static void rk4(void)
   double h[4] = {0.2, 0.1, 0.05, 0.025}, err[4], ord = NAN, q = 1.0, p = 0.5, d = NAN, dev = NAN;
   double De[16], Dn[16], dmax = 0.0;
   int i;
-  dm_builtin_pendulum(&pen, 1.0, NULL);
+  dm_builtin_pendulum(&pen, 1.0, 1.0, 1.0, NULL);
   dm_integrator_order_estimate(&pen, "rk4", NULL, &q, &p, 2.0, h, 4, NULL, NULL, err, &ord, NULL);
   tap_ok(fabs(ord - 4) < 0.1, "rk4: order %.3f", ord);
   dm_builtin_kepler(&kep, 2, 1.0, NULL);
@@ -83,7 +83,7 @@ static void gsl_crosscheck(void)
   double qr = 1.0, pr = 0.5, qg = 1.0, pg = 0.5;
   int k, st = DM_OK;
   dm_err e;
-  dm_builtin_pendulum(&pen, 1.0, NULL);
+  dm_builtin_pendulum(&pen, 1.0, 1.0, 1.0, NULL);
   dm_integ_opts_init(&o);
   o.epsabs = 1e-8;
   o.epsrel = 0.0;
@@ -156,7 +156,7 @@ static void user_prk(void)
   double h[4] = {0.2, 0.1, 0.05, 0.025}, err[4], ord = NAN, q = 1.0, p = 0.5;
   dm_err e;
   int k;
-  dm_builtin_pendulum(&pen, 1.0, NULL);
+  dm_builtin_pendulum(&pen, 1.0, 1.0, 1.0, NULL);
   dm_builtin_kepler(&kep, 2, 1.0, NULL);
   dm_tableau_prk(3, a3, b3, at3, NULL, NULL, 0, &t3, NULL);
   dm_integ_opts_init(&o);

@@ -43,7 +43,7 @@ static void sampling(void)
   double q = 1.0, p = 0.5, qq = 1.0, pp = 0.5;
   int st, k;
   dm_err e;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   dm_integrator_new(&s, "gauss", NULL, &I, NULL);
   memset(&r, 0, sizeof r);
   st = dm_integrator_run(I, 2.385, &q, &p, 0.1, 10, 3, record, &r, &info, &e);
@@ -68,7 +68,7 @@ static void stops(void)
   double q = 1.0, p = 0.5;
   int st;
   dm_err e;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   dm_integrator_new(&s, "lobatto", NULL, &I, NULL);
   /* Ctrl-C: the flag raised from inside the run stops it before the next step */
   memset(&r, 0, sizeof r);
@@ -171,7 +171,7 @@ static void errors(void)
   dm_run_info info;
   double q = NAN, p = 0.5, q2[2] = {0.3, 0.2}, p2[2] = {0.1, 0.1}, v2[2];
   int st;
-  dm_builtin_pendulum(&s, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
   tap_is_int(dm_integrator_new(&s, "leapfrog9", NULL, &I, &e), DM_ENOTFOUND, "unknown method rejected");
   tap_ok(I == NULL && strstr(e.msg, "leapfrog9") && strstr(e.msg, "gauss") && strstr(e.msg, "gsl:<stepper>"),
          "message lists the methods: %s", e.msg);
@@ -324,8 +324,8 @@ static void registration(void)
   double q = 2.385, p = 0.5;
   dm_err e;
   int st;
-  dm_builtin_pendulum(&s, 1.0, NULL);
-  dm_builtin_pendulum(&k, 1.0, NULL);
+  dm_builtin_pendulum(&s, 1.0, 1.0, 1.0, NULL);
+  dm_builtin_pendulum(&k, 1.0, 1.0, 1.0, NULL);
   k.kind = "test-kind";
   st = dm_integrator_new(&k, "gauss", NULL, &I, &e);
   tap_ok(st == DM_ENOTFOUND && I == NULL && strstr(e.msg, "method 'gauss' does not apply to system")

@@ -175,7 +175,7 @@ int main(void)
                      dm_expr_powi(c, T.q[2], 2));
     g = dm_expr_sub(c, r2, dm_expr_powi(c, T.par[1], 2));
     compile(&T, 3, L, 2, pv, NULL, 1, &g, &tr);
-    dm_builtin_spherical_pendulum_r3(&bi, 9.81, 1.3, 0, NULL);
+    dm_builtin_spherical_pendulum_r3(&bi, 9.81, 1.3, 1.0, 0, NULL);
     d = run_diff(&tr, &bi, "lobatto", 3, 0.05, 200, q0, p0, &f);
     tap_ok(d < 1e-12, "spherical pendulum in R3, Lobatto 3 with stage multipliers: traced = C (%.2g)", d);
     d = run_diff(&tr, &bi, "trapezoid", 0, 0.05, 200, q0, p0, &f);
@@ -202,7 +202,7 @@ int main(void)
                                 dm_expr_mul(c, dm_expr_powi(c, T.par[0], 2), dm_expr_powi(c, T.q[0], 2))));
     F = dm_expr_neg(c, dm_expr_mul(c, T.par[1], T.v[0]));
     compile(&T, 1, L, 2, pv, &F, 0, NULL, &tr);
-    dm_builtin_damped_oscillator(&bi, 2.385, 0.1, NULL);
+    dm_builtin_damped_oscillator(&bi, 1.0, 2.385, 0.1, NULL);
     d = run_diff(&tr, &bi, "gauss", 2, 0.05, 400, q0, p0, &f);
     tap_ok(d < 1e-13, "damped oscillator, forced Gauss 2: traced = C (%.2g)", d);
     dm_system_release(&tr);

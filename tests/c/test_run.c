@@ -297,7 +297,7 @@ static void runaway(void)
   dm_integrator_free(I);
   /* a threshold on the energy error: explicit Stormer-Verlet beyond its
    * stability limit (h omega = 2.385 > 2) grows exponentially */
-  dm_builtin_harmonic(&h, 1.0, NULL);
+  dm_builtin_harmonic(&h, 1.0, 1.0, NULL);
   dm_integrator_new(&h, "trapezoid", NULL, &I, NULL);
   tr = dm_run_traj_alloc(I, NULL);
   dm_run_opts_init(&o);

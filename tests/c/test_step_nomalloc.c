@@ -180,8 +180,8 @@ static void test_builtin(void)
   const double qd[1] = {2.385}, pd[1] = {0.0};
   dm_builtin_j2(&j2, 0.05, NULL);
   dm_builtin_kepler(&kep, 2, 1.0, NULL);
-  dm_builtin_spherical_pendulum_r3(&sph, 9.81, 1.0, 0, NULL);
-  dm_builtin_damped_oscillator(&damp, 2.385, 0.1, NULL);
+  dm_builtin_spherical_pendulum_r3(&sph, 9.81, 1.0, 1.0, 0, NULL);
+  dm_builtin_damped_oscillator(&damp, 1.0, 2.385, 0.1, NULL);
   check_steps("J2 Gauss 2", &j2, "gauss", 2, 1, 0.05, qj, pj);
   check_steps("J2 Gauss 3, full Newton", &j2, "gauss", 3, 0, 0.05, qj, pj);
   check_steps("Kepler Lobatto 3", &kep, "lobatto", 3, 1, 0.01, qk, pk);

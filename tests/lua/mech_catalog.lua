@@ -52,7 +52,7 @@ local R = math.sqrt(x^2 + y^2 + z^2)
 local V = -1 / R + 0.05 / R^3 * (3 * z^2 / (2 * R^2) - 0.5)
 T.near(j2:energy({x, y, z}, {0, 0, 0}), V, 1e-15, "J2: V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (corrected sign)")
 T.near(j2c:energy({math.sqrt(x^2 + y^2), 0.7, z}, {0, 0, 0}), V, 1e-15, "J2 cylindrical: the same potential")
-T.near(j2:energy({x, y, z}, {0.1, 0.2, 0.3}), dm.builtin.j2{J2 = 0.05}:energy({x, y, z}, {0.1, 0.2, 0.3}), 1e-15,
+T.near(j2:energy({x, y, z}, {0.1, 0.2, 0.3}), dm.systems.j2{J2 = 0.05, impl = "c"}:energy({x, y, z}, {0.1, 0.2, 0.3}), 1e-15,
        "J2 catalog = built-in C")
 local rmin, rmax = math.huge, 0
 d, tr = drift(j2, {method = "gauss", stages = 2, h = 0.05}, {q = {2, 0, 0.3}, v = {0, 0.6, 0.1}}, 2000)
@@ -82,7 +82,7 @@ local vc = {1.3 * (math.cos(th) * math.cos(ph) * thd - math.sin(th) * math.sin(p
             1.3 * (math.cos(th) * math.sin(ph) * thd + math.sin(th) * math.cos(ph) * phd), 1.3 * math.sin(th) * thd}
 T.near(sp:energy({th, ph}, {thd, phd}), sp3:energy(qc, vc), 1e-14, "spherical pendulum: angles and R^3 energies agree")
 T.near(dm.systems.spherical_pendulum{l = 1.3}:energy({th, ph}, {thd, phd}),
-       dm.builtin.spherical_pendulum{l = 1.3}:energy({th, ph}, {thd, phd}), 1e-14, "spherical pendulum catalog = built-in C")
+       dm.systems.spherical_pendulum{l = 1.3, impl = "c"}:energy({th, ph}, {thd, phd}), 1e-14, "spherical pendulum catalog = built-in C")
 local Esp = math.abs(sp:energy({th, ph}, {thd, phd}))
 d = drift(sp, {method = "gauss", stages = 2, h = 0.02}, {q = {th, ph}, v = {thd, phd}}, 500)
 T.ok(d < 1e-5 * Esp, ("spherical pendulum, Gauss 2: energy bounded (%.2g)"):format(d))
@@ -140,10 +140,66 @@ local E = dtr2:energy()
 T.ok(E[#dtr2] < E[1] * math.exp(-0.2 * 10) * 1.1, "damped oscillator loses energy at the rate c")
 
 -- catalog errors
-T.error_like(function() dm.systems.kepler{mu = 1, J2 = 3} end, "dm.systems.kepler: unknown parameter J2 %(parameters: mu, dim%)",
+T.error_like(function() dm.systems.kepler{mu = 1, J2 = 3} end, "dm.systems.kepler: unknown parameter J2 %(parameters: mu, dim, impl%)",
              "unknown parameter")
 T.error_like(function() dm.systems.pendulum{g = "9.81"} end, "parameter g must be a number", "non-numeric parameter")
 T.error_like(function() dm.systems.harmonic(3) end, "table of parameters expected", "not a table")
 T.error_like(function() dm.systems.kepler{dim = 4} end, "dim must be 2 or 3", "Kepler dim")
 T.error_like(function() dm.systems.double_spherical_pendulum{form = "polar"} end, "form must be", "double pendulum form")
+-- one catalogue: impl = "c" is the same system written in C (same coordinates,
+-- parameters and values), also after a parameter change (the C mass follows m)
+do
+  local cases = {
+    {"harmonic", {m = 1.7, omega = 2.385}, {0.3}, {-0.8}},
+    {"damped", {m = 1.7, omega = 2.385, c = 0.3}, {0.3}, {-0.8}},
+    {"pendulum", {g = 9.81, l = 1.3, m = 0.7}, {0.9}, {2.385}},
+    {"kepler", {mu = 1.3}, {0.4, 0.7}, {-0.2, 1.1}},
+    {"kepler", {mu = 1.3, dim = 3}, {0.4, 0.7, 0.2}, {-0.2, 1.1, 0.3}},
+    {"j2", {J2 = 0.05}, {1.1, -0.4, 0.35}, {0.2, 0.9, 0.15}},
+    {"spherical_pendulum", {g = 9.81, l = 1.3, m = 0.7}, {1.2, 0.3}, {0.5, 1.5}},
+    {"spherical_pendulum_r3", {g = 9.81, l = 1.3, m = 0.7}, {0.3, 0.4, -1.2}, {0.5, -0.2, 0.07 / 1.2}},
+  }
+  for _, c in ipairs(cases) do
+    local o = {}
+    for k, v in pairs(c[2]) do o[k] = v end
+    local tr = dm.systems[c[1]](o)
+    o.impl = "c"
+    local cs = dm.systems[c[1]](o)
+    local same = table.concat(tr.coords, ",") == table.concat(cs.coords, ",") and tr.name == cs.name
+    local names = {}
+    for k in pairs(tr.params) do names[#names + 1] = k .. "=" .. tr.params[k] end
+    for k in pairs(cs.params) do same = same and cs.params[k] == tr.params[k] end
+    local function agree()
+      local d = math.abs(tr:lagrangian(c[3], c[4]) - cs:lagrangian(c[3], c[4]))
+      local pt, pc = tr:momentum(c[3], c[4]), cs:momentum(c[3], c[4])
+      for i = 1, #pt do d = math.max(d, math.abs(pt[i] - pc[i])) end
+      local st = {q = c[3], v = c[4]}
+      local o2 = tr.m > 0 and {method = "lobatto", stages = 3, h = 0.05} or {method = "gauss", stages = 2, h = 0.05}
+      local a = dm.integrator(tr, o2):step(st)
+      local b = dm.integrator(cs, o2):step(st)
+      for i = 1, #a.q do d = math.max(d, math.abs(a.q[i] - b.q[i]), math.abs(a.p[i] - b.p[i])) end
+      return d
+    end
+    local d1 = agree()
+    local pname = c[2].m and "m" or (c[2].mu and "mu" or "J2")
+    tr.params[pname] = 2.385
+    cs:set{[pname] = 2.385}
+    local d2 = agree()
+    local e = dm.integrator(tr, {method = "trapezoid", h = 0.01})
+    local f = dm.integrator(cs, {method = "trapezoid", h = 0.01})
+    local ta = e:run({q = c[3], v = c[4]}, {steps = 50})
+    local tb = f:run({q = c[3], v = c[4]}, {steps = 50})
+    local d3 = math.abs(ta:column(tr.coords[1])[51] - tb:column(tr.coords[1])[51])
+    T.ok(same and d1 <= 1e-13 and d2 <= 1e-13 and d3 <= 1e-12,
+         ("dm.systems.%s{impl = \"c\"} = the traced entry (%s): L, p, a Gauss (Lobatto) step %.2g; after %s = 2.385: %.2g; Stormer-Verlet run %.2g")
+         :format(c[1], table.concat(names, " "), d1, pname, d2, d3))
+  end
+  T.error_like(function() dm.systems.henon_heiles{impl = "c"} end,
+    "dm.systems.henon_heiles: no C implementation %(impl = \"c\" exists for damped, harmonic, j2, kepler, pendulum, spherical_pendulum, spherical_pendulum_r3%)",
+    "an entry without C says which have one")
+  T.error_like(function() dm.systems.pendulum{impl = "fortran"} end, "impl must be \"traced\" or \"c\", got fortran", "impl checked")
+  T.error_like(function() dm.systems.j2{j2 = 1, impl = "c"} end, "dm.systems.j2: unknown parameter j2 %(parameters: J2, impl%)",
+    "the C implementation checks parameters like the traced one")
+  T.ok(dm.builtin == nil, "no second catalogue (dm.builtin)")
+end
 T.done()

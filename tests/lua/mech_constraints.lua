@@ -111,14 +111,14 @@ for _, native in ipairs{false, "auto"} do
       local R = dm.sqrt(q.x^2 + q.y^2 + q.z^2)
       return 0.5 * (v.x^2 + v.y^2 + v.z^2) + 1 / R - p.J2 / R^3 * (1.5 * q.z^2 / R^2 - 0.5)
     end}
-  same("J2, Gauss 2 h=0.05", sys, dm.builtin.j2{J2 = 0.05}, {method = "gauss", stages = 2, h = 0.05}, j2s, 200)
+  same("J2, Gauss 2 h=0.05", sys, dm.systems.j2{J2 = 0.05, impl = "c"}, {method = "gauss", stages = 2, h = 0.05}, j2s, 200)
 end
-same("Kepler, explicit Stormer-Verlet h=0.01", dm.systems.kepler(), dm.builtin.kepler(),
+same("Kepler, explicit Stormer-Verlet h=0.01", dm.systems.kepler(), dm.systems.kepler{impl = "c"},
      {method = "trapezoid", h = 0.01}, {q = {0.4, 0}, p = {0, 2}}, 2000)
-same("spherical pendulum in R^3, Lobatto 3 h=0.05", r3, dm.builtin.spherical_pendulum_r3{g = g, l = l},
+same("spherical pendulum in R^3, Lobatto 3 h=0.05", r3, dm.systems.spherical_pendulum_r3{g = g, l = l, impl = "c"},
      {method = "lobatto", stages = 3, h = 0.05}, {q = q0, v = v0}, 200)
-same("spherical pendulum in angles, Gauss 2 h=0.05", ang, dm.builtin.spherical_pendulum{g = g, l = l},
+same("spherical pendulum in angles, Gauss 2 h=0.05", ang, dm.systems.spherical_pendulum{g = g, l = l, impl = "c"},
      {method = "gauss", stages = 2, h = 0.05}, {q = {th, ph}, v = {thd, phd}}, 200)
-same("damped oscillator, Gauss 2 h=0.1", damped, dm.builtin.damped{omega = omega, c = c},
+same("damped oscillator, Gauss 2 h=0.1", damped, dm.systems.damped{omega = omega, c = c, impl = "c"},
      {method = "gauss", stages = 2, h = 0.1}, {q = {x0}, p = {u0}}, 500)
 T.done()

@@ -6,7 +6,7 @@ D="$DMECH"
 T="$DMECH_TESTTMP/mech_interrupt"; mkdir -p "$T"
 
 cat > "$T/long.lua" <<'LUA'
-local I = dm.integrator(dm.builtin.kepler(), {method = "trapezoid", h = 0.01})
+local I = dm.integrator(dm.systems.kepler{impl = "c"}, {method = "trapezoid", h = 0.01})
 local tr, msg = I:run({q = {0.4, 0}, p = {0, 2}}, {steps = 4000000000, every = 1000000, progress = true})
 print(tr ~= nil, #tr > 1, tr:column("t")[#tr] > 0)
 print(msg)
@@ -29,6 +29,6 @@ like "$out" "run: interrupted after step [0-9]+ of 4000000000 \(t = [0-9.e+]+\);
 like "$out" "after the run	0.01" "the session goes on (the interrupt was consumed)"
 if printf '%s\n' "$err" | grep -q "interrupted!"; then ok 1 "no Lua 'interrupted!' error"; else ok 0 "no Lua 'interrupted!' error"; fi
 
-out=$("$D" -e 'local tr = dm.integrator(dm.builtin.kepler(), {h = 0.01, method = "trapezoid"}):run({q = {0.4, 0}, p = {0, 2}}, {steps = 1000}); print(#tr)' 2>&1)
+out=$("$D" -e 'local tr = dm.integrator(dm.systems.kepler{impl = "c"}, {h = 0.01, method = "trapezoid"}):run({q = {0.4, 0}, p = {0, 2}}, {steps = 1000}); print(#tr)' 2>&1)
 is "$out" "1001" "short runs print no progress (stdout not a terminal)"
 done_testing
