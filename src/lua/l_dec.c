@@ -13,6 +13,7 @@
 /* {==== helpers ==================================================================== */
 
 static const char *const simplex_names[] = {"vertex", "edge", "triangle", "tetrahedron", "4-simplex"};
+static const char *const simplex_plurals[] = {"vertices", "edges", "triangles", "tetrahedra", "4-simplices"};
 
 const char *dm_dec_typename(lua_State *L, dm_ltype t)
 {
@@ -120,9 +121,9 @@ static void warn_star(dm_lmesh *M, int k)
   if (M->G->nonpos[k] > 0 && !(M->warned & (1u << k))) {
     M->warned |= 1u << k;
     fprintf(stderr,
-            "dmech: warning: %d %s%s of this mesh %s non-positive dual volume (not Delaunay there): "
+            "dmech: warning: %d %s of this mesh %s non-positive dual volume (not Delaunay there): "
             "*%d is indefinite\n",
-            M->G->nonpos[k], simplex_names[k], M->G->nonpos[k] > 1 ? (k == 0 ? "es" : "s") : "",
+            M->G->nonpos[k], M->G->nonpos[k] > 1 ? simplex_plurals[k] : simplex_names[k],
             M->G->nonpos[k] > 1 ? "have" : "has", k);
   }
 }
@@ -403,12 +404,8 @@ static int m_tostring(lua_State *L)
     lua_pushfstring(L, "mesh of dimension %d (intrinsic):", M->K->n);
   luaL_addvalue(&b);
   for (k = 0; k <= M->K->n; k++) {
-    lua_pushfstring(L, "%s %d %s%s", k ? "," : "", M->K->nsimp[k], simplex_names[k],
-                    M->K->nsimp[k] == 1 ? "" : (k == 0 ? "es" : "s"));
-    if (k == 0 && M->K->nsimp[0] != 1) {
-      lua_pop(L, 1);
-      lua_pushfstring(L, " %d vertices", M->K->nsimp[0]);
-    }
+    lua_pushfstring(L, "%s %d %s", k ? "," : "", M->K->nsimp[k],
+                    M->K->nsimp[k] == 1 ? simplex_names[k] : simplex_plurals[k]);
     luaL_addvalue(&b);
   }
   luaL_pushresult(&b);
@@ -781,8 +778,8 @@ static int m_eigen(lua_State *L)
     return luaL_error(L, "mesh:eigen: number of eigenpairs in 1..%d expected, got %I", nk - 1, nev);
   for (i = k > 0 ? k - 1 : 0; i <= k + 1 && i <= M->K->n; i++)
     if (M->G->nonpos[i] > 0)
-      return luaL_error(L, "mesh:eigen: %d %ss have non-positive dual volume: the problem is not definite",
-                        M->G->nonpos[i], simplex_names[i]);
+      return luaL_error(L, "mesh:eigen: %d %s non-positive dual volume: the problem is not definite",
+                        M->G->nonpos[i], M->G->nonpos[i] > 1 ? simplex_plurals[i] : simplex_names[i]);
   m = lua_newuserdatauv(L, (size_t)nk * sizeof *m, 0);
   lam = lua_newuserdatauv(L, (size_t)nev * sizeof *lam, 0);
   vec = lua_newuserdatauv(L, (size_t)nk * (size_t)nev * sizeof *vec, 0);

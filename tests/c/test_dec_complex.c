@@ -251,6 +251,34 @@ int main(void)
     tap_ok(dm_dec_gen_torus(2, 1, 10, 7, &e) == NULL &&
            strcmp(e.msg, "torus: R > r > 0, m >= 3 and an even n >= 4 expected") == 0, "%s", e.msg);
   }
+  /* the constant local-face tables against a direct enumeration */
+  {
+    int n, ok = 1;
+    for (n = 1; n <= DM_DEC_MAXDIM; n++) {
+      int cnt[DM_DEC_MAXDIM + 1] = {0};
+      unsigned mk, prev[DM_DEC_MAXDIM + 1] = {0};
+      for (mk = 1; mk < (1u << (n + 1)); mk++) {
+        int kk = __builtin_popcount(mk) - 1, j = dm_dec_face_index(n, mk);
+        ok = ok && dm_dec_face_mask(n, kk, j) == mk;
+        cnt[kk]++;
+      }
+      for (k = 0; k <= n; k++) {
+        int j, c = 0;
+        for (j = 0; dm_dec_face_mask(n, k, j) != 0 && j < 10; j++) {
+          unsigned a = dm_dec_face_mask(n, k, j), b = prev[k];
+          /* lexicographic order of the vertex tuples: compare lowest differing bit */
+          if (j > 0) {
+            unsigned d = a ^ b;
+            ok = ok && (d & -d & b) != 0;
+          }
+          prev[k] = a;
+          c++;
+        }
+        ok = ok && c == cnt[k];
+      }
+    }
+    tap_ok(ok, "local face tables: masks and indices invert each other, lexicographic order");
+  }
   dm_dec_complex_free(NULL);
   dm_dec_meshdata_free(NULL);
   return tap_done();

@@ -144,4 +144,19 @@ T.ok(math.abs(Mx[1] - 1) < 1e-14 and math.abs(Mx[3] - 3) < 1e-14, "UMFPACK solve
 T.is(tostring(M), "sparse 3x3, 5 nonzeros", "tostring of a plain matrix")
 T.error_like(function() return dm.sparse(2, 2, {{3, 1, 1}}) end, "entry 1: index %(3, 1%) outside 2 x 2", "triplet out of range")
 T.error_like(function() return M * {1, 2} end, "vector of length 3 expected, got length 2", "matrix times short vector")
+
+-- a warning on stderr, once per mesh and degree, for non-positive duals
+local exe = os.getenv("DMECH")
+if exe then
+  local cmd = exe .. [[ -e 'local M = dm.mesh.new{vertices = {{0,0},{2,0},{1,0.4},{1,-0.4}}, simplices = {{1,2,3},{2,1,4}}}; M:laplacian(0); M:laplacian(0); M:star(1)' 2>&1]]
+  local p = io.popen(cmd)
+  local out = p:read("a")
+  p:close()
+  local _, count = out:gsub("dmech: warning:", "")
+  T.ok(out:find("dmech: warning: 2 vertices of this mesh have non%-positive dual volume %(not Delaunay there%): %*0 is indefinite")
+       and out:find("1 edge of this mesh has non%-positive dual volume") and count == 2,
+       "non-Delaunay mesh: one warning per degree on stderr")
+else
+  T.skip("DMECH not set")
+end
 T.done()
