@@ -248,6 +248,13 @@ enum { DM_DEC_WEDGE_BARYCENTRIC = 0, DM_DEC_WEDGE_CIRCUMCENTRIC = 1 };
 int dm_dec_wedge(const dm_dec_geom *G, int k, const double *a, int l, const double *b,
                  int weights, double *out, dm_err *e);
 
+/* The thesis's dual-dual wedge (Def 3.25; a sketch there, no property
+ * proved): dual k-cochain a (N_{n-k} values) ^ dual l-cochain b -> dual
+ * (k+l)-cochain (N_{n-k-l} values), combinatorial (no metric).  Only
+ * anti-commutativity is tested; the Lua surface hides it behind a flag. */
+int dm_dec_wedge_dual(const dm_dec_complex *K, int k, const double *a, int l, const double *b,
+                      double *out, dm_err *e);
+
 /* Algebraic contraction of a dual k-cochain beta (N_{n-k} values, k >= 1)
  * with a dual vector field X: (-1)^(k(n-k)) *((*beta) ^ X^flat), a dual
  * (k-1)-cochain (N_{n-k+1} values); Lie derivative by Cartan's formula

@@ -45,7 +45,7 @@ static double value(const dm_dec_complex *K, int q, const double *c, const int *
 /* All permutations of 0..m-1 with their signs (m <= NV). */
 static int permutations(int m, int perm[][NV], int *sign)
 {
-  int cnt = 0, a[NV], c[NV], i, s = 1;
+  int cnt = 0, a[NV] = {0}, c[NV] = {0}, i, s = 1;
   for (i = 0; i < m; i++) {
     a[i] = i;
     c[i] = 0;
@@ -120,6 +120,84 @@ int dm_dec_wedge(const dm_dec_geom *G, int k, const double *a, int l, const doub
       acc += sign[q] * w[perm[q][k]] * value(K, k, a, L1, s) * value(K, l, b, L2, s);
     }
     out[s] = acc / fact[p];
+  }
+  return DM_OK;
+}
+
+/* Value of a dual cochain on the dual cell of the ordered simplex L (q+1
+ * vertices): the dual orientation follows the primal one. */
+static double dual_value(const dm_dec_complex *K, int q, const double *c, const int *L, int top)
+{
+  int s[NV], sg, id;
+  memcpy(s, L, (size_t)(q + 1) * sizeof *s);
+  sg = parity_sort(s, q + 1);
+  if (q == K->n)                      /* the top simplex itself */
+    return sg * K->top_sign[top] * c[top];
+  id = dm_dec_find(K, q, s);
+  return id < 0 ? 0.0 : sg * c[id];
+}
+
+/* The thesis's dual-dual wedge (Def 3.25), purely combinatorial:
+ *   <a ^ b, *rho> = sum over top s > rho of sign(s, [others, rho])
+ *     sum_{t in S_{k+l}} sign(t) a(*[o_t(0..l-1), rho]) b(*[o_t(l..k+l-1), rho])
+ * for a dual k-cochain a (N_{n-k} values) and a dual l-cochain b; rho runs
+ * over the (n-k-l)-simplices.  No property beyond anti-commutativity is
+ * claimed. */
+int dm_dec_wedge_dual(const dm_dec_complex *K, int k, const double *a, int l, const double *b,
+                      double *out, dm_err *e)
+{
+  int n = K->n, p = k + l, q = n - p, t, np, i, j, w;
+  int perm[120][NV], sign[120];
+  if (k < 0 || l < 0 || p > n)
+    return dm_err_set(e, DM_EINVAL, "dual wedge: degrees %d + %d exceed the dimension %d", k, l, n);
+  memset(out, 0, (size_t)K->nsimp[q] * sizeof *out);
+  np = p > 0 ? permutations(p, perm, sign) : 1;
+  if (p == 0) {
+    perm[0][0] = 0;
+    sign[0] = 1;
+  }
+  for (t = 0; t < K->nsimp[n]; t++) {
+    const int *top = K->top + (size_t)t * (n + 1);
+    int nf = K->nface[q];
+    for (j = 0; j < nf; j++) {
+      int rho = K->face[q][(size_t)t * nf + j], ord[NV], others[NV], no = 0, c = 0, par;
+      const int *rv = K->simp[q] + (size_t)rho * (q + 1);
+      double acc = 0.0;
+      for (i = 0; i <= n; i++) {
+        int in = 0;
+        for (w = 0; w <= q; w++)
+          in |= top[i] == rv[w];
+        if (!in)
+          others[no++] = top[i];
+      }
+      for (i = 0; i < no; i++)
+        ord[c++] = others[i];
+      for (w = 0; w <= q; w++)
+        ord[c++] = rv[w];
+      /* parity of ord against the stored orientation of the top simplex */
+      {
+        int pos[NV], x;
+        for (i = 0; i <= n; i++)
+          for (x = 0; x <= n; x++)
+            if (ord[i] == top[x])
+              pos[i] = x;
+        par = parity_sort(pos, n + 1);
+      }
+      for (i = 0; i < np; i++) {
+        int L1[NV], L2[NV], m = 0;
+        for (w = 0; w < l; w++)
+          L1[m++] = others[perm[i][w]];
+        for (w = 0; w <= q; w++)
+          L1[m++] = rv[w];
+        m = 0;
+        for (w = l; w < p; w++)
+          L2[m++] = others[perm[i][w]];
+        for (w = 0; w <= q; w++)
+          L2[m++] = rv[w];
+        acc += sign[i] * dual_value(K, n - k, a, L1, t) * dual_value(K, n - l, b, L2, t);
+      }
+      out[rho] += par * acc;
+    }
   }
   return DM_OK;
 }

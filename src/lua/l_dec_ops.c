@@ -123,12 +123,42 @@ static int m_save(lua_State *L)
   return 1;
 }
 
+/* Both dual: the thesis's dual-dual wedge, only with {dual_dual = true}. */
+static int wedge_dual(lua_State *L, dm_lmesh *M, dm_lcochain *a, dm_lcochain *b)
+{
+  dm_lcochain *r;
+  dm_err e;
+  int ok = 0;
+  if (lua_istable(L, 4)) {
+    lua_getfield(L, 4, "dual_dual");
+    ok = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+  }
+  if (!ok)
+    return luaL_error(L, "mesh:wedge: the dual-dual wedge is a sketch in the thesis (no property proved "
+                      "but anti-commutativity); pass {dual_dual = true} to use it");
+  if (a->t.deg + b->t.deg > M->K->n)
+    return luaL_error(L, "mesh:wedge: degrees %d + %d exceed the dimension %d", a->t.deg, b->t.deg, M->K->n);
+  r = dm_newcochain(L, 1, (dm_ltype){a->t.deg + b->t.deg, 1});
+  if (dm_dec_wedge_dual(M->K, a->t.deg, a->v, b->t.deg, b->v, r->v, &e) != DM_OK)
+    return dm_lua_fail(L, "mesh:wedge", e.status, &e);
+  return 1;
+}
+
 static int m_wedge(lua_State *L)
 {
   dm_lmesh *M = dm_checkmesh(L, 1);
-  dm_lcochain *a = cochain_of(L, 2, M, 0, "mesh:wedge"), *b = cochain_of(L, 3, M, 0, "mesh:wedge"), *r;
-  int w = weights_opt(L, 4, "mesh:wedge");
+  dm_lcochain *a, *b, *r;
+  int w;
   dm_err e;
+  lua_settop(L, 4);
+  a = dm_checkcochain(L, 2);
+  b = dm_checkcochain(L, 3);
+  if (a->t.dual && b->t.dual && a->K == M->K && b->K == M->K)
+    return wedge_dual(L, M, a, b);
+  a = cochain_of(L, 2, M, 0, "mesh:wedge");
+  b = cochain_of(L, 3, M, 0, "mesh:wedge");
+  w = weights_opt(L, 4, "mesh:wedge");
   if (a->t.deg + b->t.deg > M->K->n)
     return luaL_error(L, "mesh:wedge: degrees %d + %d exceed the dimension %d", a->t.deg, b->t.deg, M->K->n);
   r = dm_newcochain(L, 1, (dm_ltype){a->t.deg + b->t.deg, 0});
@@ -403,8 +433,8 @@ fail:
 static const dm_reg ops_methods[] = {
   {"save", m_save, "M:save(\"file.off|obj|msh\") -> true",
    "Write the mesh as OFF or OBJ (triangle meshes) or Gmsh .msh 2.2, through a temporary file."},
-  {"wedge", m_wedge, "M:wedge(a, b[, {weights = \"barycentric\" | \"circumcentric\"}]) -> cochain",
-   "The wedge product of two primal cochains (barycentric weights: Leibniz rule exact; circumcentric: the thesis's)."},
+  {"wedge", m_wedge, "M:wedge(a, b[, {weights = \"barycentric\" | \"circumcentric\", dual_dual = true}]) -> cochain",
+   "The wedge product of two primal cochains (barycentric weights: Leibniz rule exact; circumcentric: the thesis's), or of two dual ones with dual_dual = true (an unproven sketch)."},
   {"flat", m_flat, "M:flat(X) -> cochain",
    "The primal 1-cochain of a dual vector field X (function of the circumcentre, constant vector, one vector per top simplex, or mat)."},
   {"sharp", m_sharp, "M:sharp(alpha) -> mat",

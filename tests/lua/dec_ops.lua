@@ -80,6 +80,13 @@ local g = H * (D:d(0) * f0)
 T.ok(math.abs(g[apex]) < 1e-15 and (D:d(0) * g - D:d(0) * f0):norm(math.huge) < 1e-13, "H(df) = f - f(apex), d H df = df")
 T.error_like(function() return dm.mesh.annulus{}:homotopy(1) end, "no collapse to a point", "annulus is not collapsible")
 
+-- the dual-dual wedge only behind its flag
+local da = D:cochain(1, function(x, y) return y, x * x end)
+local dua, dub = D:star(1) * da, D:star(1) * (D:d(0) * f0)
+T.error_like(function() return D:wedge(dua, dub) end, "pass {dual_dual = true}", "dual-dual wedge needs its flag")
+T.ok((D:wedge(dua, dub, {dual_dual = true}) + D:wedge(dub, dua, {dual_dual = true})):norm(math.huge) < 1e-13,
+  "dual-dual wedge of 1-forms is anti-commutative")
+
 -- discrete maps: cochains move along, d commutes, geometry changes
 local M2 = D:moved(function(x, y) return 1.5 * x + 0.2 * y, 0.8 * y + 0.1 end)
 local fm = M2:cochain(0, f0)
