@@ -30,6 +30,8 @@ struct dm_traj {
   size_t nstate;      /* 1 + n * (1 + has p + has v): first extra column */
   column *cols;
   size_t ncols, colcap;
+  size_t *hidx;       /* name hash index: slots hold column + 1, 0 empty; */
+  size_t hcap;        /* NULL (linear search) while few columns or no memory */
   size_t len, cap;    /* samples stored, samples every column can hold */
   meta *m;            /* metadata in insertion order */
   size_t nmeta, metacap;
@@ -69,11 +71,72 @@ static int bad_name(dm_err *e, const char *what, const char *s)
                     DM_TRAJ_NAME_MAX + 8, s, DM_TRAJ_NAME_MAX);
 }
 
+/* {==== the name index ===================================================
+ * Wide trajectories (a CSV file of 10^5 columns) must not make every name
+ * lookup, and so every column added, cost O(columns): past INDEX_FROM
+ * columns names are found through an open-addressing hash table, kept up
+ * to date by every change of the column list.  If its memory cannot be
+ * had, lookups fall back to the linear search (same answers). */
+
+#define INDEX_FROM 32
+
+static size_t name_hash(const char *s)
+{
+  uint64_t h = 1469598103934665603ULL;            /* FNV-1a */
+  for (; *s != '\0'; s++)
+    h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+  return (size_t)(h ^ (h >> 32));
+}
+
+static void index_put(dm_traj *tr, size_t j)
+{
+  size_t k = name_hash(tr->cols[j].name) & (tr->hcap - 1);
+  while (tr->hidx[k] != 0)
+    k = (k + 1) & (tr->hcap - 1);
+  tr->hidx[k] = j + 1;
+}
+
+/* Rebuild for the current columns (load <= 1/2), or drop it. */
+static void index_rebuild(dm_traj *tr)
+{
+  size_t cap = 64, j;
+  free(tr->hidx);
+  tr->hidx = NULL;
+  tr->hcap = 0;
+  if (tr->ncols < INDEX_FROM)
+    return;
+  while (cap < 2 * tr->ncols)
+    cap *= 2;
+  if ((tr->hidx = calloc(cap, sizeof *tr->hidx)) == NULL)
+    return;
+  tr->hcap = cap;
+  for (j = 0; j < tr->ncols; j++)
+    index_put(tr, j);
+}
+
+/* Column j (the last one) was just appended. */
+static void index_added(dm_traj *tr, size_t j)
+{
+  if (tr->hidx != NULL && 2 * tr->ncols <= tr->hcap)
+    index_put(tr, j);
+  else if (tr->ncols >= INDEX_FROM)
+    index_rebuild(tr);
+}
+
+/* }==== */
+
 size_t dm_traj_find(const dm_traj *tr, const char *name)
 {
   size_t j;
   if (tr == NULL || name == NULL)
     return DM_TRAJ_NONE;
+  if (tr->hidx != NULL) {
+    size_t k = name_hash(name) & (tr->hcap - 1);
+    for (; tr->hidx[k] != 0; k = (k + 1) & (tr->hcap - 1))
+      if (strcmp(tr->cols[tr->hidx[k] - 1].name, name) == 0)
+        return tr->hidx[k] - 1;
+    return DM_TRAJ_NONE;
+  }
   for (j = 0; j < tr->ncols; j++)
     if (strcmp(tr->cols[j].name, name) == 0)
       return j;
@@ -152,6 +215,7 @@ static int push_col(dm_traj *tr, const char *prefix, const char *name,
   tr->cols[tr->ncols].kind = kind;
   tr->cols[tr->ncols].x = NULL;
   tr->ncols++;
+  index_added(tr, tr->ncols - 1);
   return DM_OK;
 }
 
@@ -218,6 +282,7 @@ void dm_traj_free(dm_traj *tr)
     free(tr->cols[j].x);
   }
   free(tr->cols);
+  free(tr->hidx);
   for (j = 0; j < tr->nmeta; j++) {
     free(tr->m[j].key);
     free(tr->m[j].val);
@@ -457,6 +522,8 @@ static void install(dm_traj *tr, size_t m, char **names, int kind,
     c->x = xs[a];
     names[a] = NULL;
     xs[a] = NULL;
+    if (slot[a] == DM_TRAJ_NONE)
+      index_added(tr, tr->ncols - 1);
   }
 }
 
@@ -466,7 +533,7 @@ static int prepare(dm_traj *tr, size_t m, const char *const *names,
 {
   size_t a;
   if (tr->ncols + m > tr->colcap) {
-    size_t nc = tr->ncols + m + 8;
+    size_t nc = tr->ncols + m + tr->ncols / 2 + 8;      /* geometric */
     column *c = realloc(tr->cols, nc * sizeof *c);
     if (c == NULL)
       return dm_err_set(e, DM_ENOMEM, "trajectory: out of memory for columns");
@@ -525,6 +592,7 @@ int dm_traj_remove_column(dm_traj *tr, const char *name, dm_err *e)
   free(tr->cols[j].x);
   memmove(&tr->cols[j], &tr->cols[j + 1], (tr->ncols - j - 1) * sizeof *tr->cols);
   tr->ncols--;
+  index_rebuild(tr);
   return DM_OK;
 }
 

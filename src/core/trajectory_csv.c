@@ -72,7 +72,7 @@ static int write_body(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
 {
   size_t k, j, nc = dm_traj_ncols(tr), len = dm_traj_len(tr);
   for (k = 0; k < len; k++) {
-    if (k % POLL_EVERY == 0 && dm_interrupted())
+    if ((k % POLL_EVERY == 0 || nc > 256) && dm_interrupted())
       return dm_err_set(e, DM_EINTR, "saving '%.200s': interrupted at sample "
                         "%zu of %zu", name, k, len);
     for (j = 0; j < nc; j++)
@@ -348,6 +348,31 @@ static int read_comment(reader *r, preamble *pr)
   return DM_OK;                  /* any other comment is ignored */
 }
 
+static int cmp_name(const void *a, const void *b)
+{
+  return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* A name used twice in the header, found by sorting a copy of the list
+ * (O(n log n): a header of 10^5 names took 30 s with the pairwise test). */
+static int twice(reader *r, char **names, size_t nc)
+{
+  char **sorted = malloc(nc * sizeof *sorted);
+  size_t i;
+  int st = DM_OK;
+  if (sorted == NULL)
+    return dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory",
+                      r->path);
+  memcpy(sorted, names, nc * sizeof *sorted);
+  qsort(sorted, nc, sizeof *sorted, cmp_name);
+  for (i = 1; i < nc && st == DM_OK; i++)
+    if (strcmp(sorted[i], sorted[i - 1]) == 0)
+      st = fail_at(r, "column '%.100s' appears twice in the header%s",
+                   sorted[i], "");
+  free(sorted);
+  return st;
+}
+
 /* Check the kinds against the header names: t, n q, [n p], [n v], extras. */
 static int layout(reader *r, char **names, char **kinds, size_t nc,
                   size_t *n, unsigned *flags, int *kind)
@@ -360,11 +385,11 @@ static int layout(reader *r, char **names, char **kinds, size_t nc,
       return fail_at(r, "unknown column kind '%.50s' in '# kinds' (expected t, "
                      "q, p, v, diag, derived or data)%s", kinds[i], "");
   }
-  for (i = 1; i < nc; i++)
-    for (j = 0; j < i; j++)
-      if (strcmp(names[i], names[j]) == 0)
-        return fail_at(r, "column '%.100s' appears twice in the header%s",
-                       names[i], "");
+  {
+    int st = twice(r, names, nc);
+    if (st != DM_OK)
+      return st;
+  }
   j = 1;
   if (kind[0] != DM_TRAJ_T || strcmp(names[0], "t") != 0)
     return fail_at(r, "the first column must be 't' of kind t (got '%.100s' "
@@ -517,7 +542,7 @@ static int read_rows(reader *r, dm_traj *tr, size_t nc)
     j += n;
   }
   while (st == DM_OK && (got = next_line(r)) > 0) {
-    if (r->lineno % POLL_EVERY == 0 && dm_interrupted())
+    if ((r->lineno % POLL_EVERY == 0 || nc > 256) && dm_interrupted())
       st = dm_err_set(r->e, DM_EINTR, "reading '%.200s': interrupted at line "
                       "%zu", r->path, r->lineno);
     else if ((st = parse_row(r, tr, nc, row)) == DM_OK)
