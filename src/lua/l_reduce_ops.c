@@ -282,7 +282,7 @@ static int m_reconstruct(lua_State *L)
   st = dm_routh_reconstruct(u->red, I, h, rt, th, &out, &e);
   *slot = out;
   if (st != DM_OK && st != DM_EINTR)
-    return dm_lua_fail(L, "reconstruct", st, &e);
+    return dm_lua_fail(L, "red:reconstruct", st, &e);
   if (st == DM_EINTR) {
     lua_pushstring(L, e.msg);
     return 2;

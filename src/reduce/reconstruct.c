@@ -208,6 +208,26 @@ int dm_routh_lift_state(dm_routh *red, const double *theta, const double *x, con
   return full_velocity(red, x, s_, xd, v, e);
 }
 
+/* A trajectory of another system with as many coordinates (Kepler's x, y
+ * taken for r, z) was reconstructed without a word: the coordinate names
+ * must be the shape coordinates', and a trajectory that says which system
+ * it came from must come from this reduced system. */
+static int check_origin(const dm_routh *red, const dm_traj *rt, dm_err *e)
+{
+  const char *from = dm_traj_meta_get(rt, "system");
+  for (size_t i = 0; i < red->s; i++)
+    if (strcmp(dm_traj_coord(rt, i), red->names[i]) != 0)
+      return dm_err_set(e, DM_EINVAL, "the reduced trajectory's coordinate %zu is '%.60s' "
+                        "where this reduction's shape coordinate is '%.60s' (a trajectory "
+                        "of another system?)", i + 1, dm_traj_coord(rt, i), red->names[i]);
+  if (from != NULL && red->sys.name != NULL && strcmp(from, red->sys.name) != 0)
+    return dm_err_set(e, DM_EINVAL, "the trajectory comes from system '%.100s', not from "
+                      "'%.100s'%s", from, red->sys.name,
+                      red->fsys.name != NULL && strcmp(from, red->fsys.name) == 0
+                      ? " (reconstruct takes a run of the reduced system)" : "");
+  return DM_OK;
+}
+
 int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_traj *rt,
                          const double *theta0, dm_traj **out, dm_err *e)
 {
@@ -219,11 +239,13 @@ int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_tra
   *out = NULL;
   dm_routh *owner = NULL;
   if (!dm_routh_is_integrator(I) || !dm_routh_of_system(I->sys, &owner) || owner != red)
-    return dm_err_set(e, DM_EINVAL, "reconstruct: the integrator must be a reduced integrator of "
-                      "this reduction");
+    return dm_err_set(e, DM_EINVAL, "the integrator must be a reduced integrator of this "
+                      "reduction");
   if (rt == NULL || dm_traj_ncoords(rt) != d || d > 64)
-    return dm_err_set(e, DM_EINVAL, "reconstruct: the reduced trajectory must have the %zu shape "
-                      "coordinates", d);
+    return dm_err_set(e, DM_EINVAL, "the reduced trajectory must have the %zu shape "
+                      "coordinates, got %zu", d, rt != NULL ? dm_traj_ncoords(rt) : 0);
+  if ((st = check_origin(red, rt, e)) != DM_OK)
+    return st;
   len = dm_traj_len(rt);
   for (i = 0; i < d; i++) {
     jq[i] = dm_traj_qcol(rt, i);
@@ -232,7 +254,7 @@ int dm_routh_reconstruct(dm_routh *red, dm_integrator *I, double h, const dm_tra
     if (jp[i] == DM_TRAJ_NONE)
       use_p = 0;
     if (!use_p && jv[i] == DM_TRAJ_NONE)
-      return dm_err_set(e, DM_EINVAL, "reconstruct: the reduced trajectory needs momentum (p) or "
+      return dm_err_set(e, DM_EINVAL, "the reduced trajectory needs momentum (p) or "
                         "velocity (v) columns");
   }
   if ((buf = malloc((6 * d + 3 * n) * sizeof(double))) == NULL)
