@@ -9,12 +9,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/interrupt.h"
+#include "core/numfmt.h"
 
 /* {==== options ========================================================== */
 
 #define OPT(f) offsetof(dm_integ_opts, f), sizeof(((dm_integ_opts *)0)->f)
 const dm_option_desc dm_integ_options[] = {
-  {"stages", DM_OPT_INT, OPT(stages), 0, DM_TABLEAU_SMAX,
+  {"stages", DM_OPT_INT, OPT(stages), 1, DM_TABLEAU_SMAX,
    "number of stages: gauss >= 1 (default 2), lobatto >= 2 (default 3)"},
   {"h", DM_OPT_DOUBLE, OPT(h), -HUGE_VAL, HUGE_VAL, "step size (negative: backwards in time)"},
   {"tol", DM_OPT_DOUBLE, OPT(tol), DBL_EPSILON, 1e-2,
@@ -65,11 +66,20 @@ int dm_integ_opts_set_number(dm_integ_opts *o, const char *name, double v, dm_er
     return dm_err_set(e, DM_ENOTFOUND, "unknown integrator option '%s'", name ? name : "(null)");
   if (d->kind == DM_OPT_STRING)
     return dm_err_set(e, DM_EINVAL, "option '%s' expects a string", d->name);
-  if (!(v >= d->min && v <= d->max) || (d->kind != DM_OPT_DOUBLE && v != floor(v)))
-    return dm_err_set(e, DM_EINVAL, "option '%s' = %g out of range (%s %g..%g)", d->name, v,
+  if (!(v >= d->min && v <= d->max) || (d->kind != DM_OPT_DOUBLE && v != floor(v))) {
+    char got[DM_NUM_BUFSIZE], lo[DM_NUM_BUFSIZE], hi[DM_NUM_BUFSIZE];
+    dm_num_format(got, sizeof got, v);
+    dm_num_format(lo, sizeof lo, d->min);
+    dm_num_format(hi, sizeof hi, d->max);
+    if (v != v)
+      return dm_err_set(e, DM_EINVAL, "option '%s' must be a number, got nan", d->name);
+    if (d->kind == DM_OPT_DOUBLE && d->min == -HUGE_VAL && d->max == HUGE_VAL)
+      return dm_err_set(e, DM_EINVAL, "option '%s' must be finite, got %s", d->name, got);
+    return dm_err_set(e, DM_EINVAL, "option '%s' = %s out of range (%s %s..%s)", d->name, got,
                       d->kind == DM_OPT_DOUBLE ? "number" : d->kind == DM_OPT_BOOL ? "boolean"
                                                                                : "integer",
-                      d->min, d->max);
+                      lo, hi);
+  }
   if (d->kind == DM_OPT_DOUBLE)
     *(double *)(f + d->offset) = v;
   else

@@ -137,7 +137,11 @@ static int m_unsupported(lua_State *L)
                     "defined for expressions");
 }
 
-/* `if x < 0` on an expression: there is no truth value to branch on. */
+/* `if x < 0` on an expression: there is no truth value to branch on.
+ * Two branches on symbolic values cannot be caught at all: Lua decides
+ * `x == 0` (an expression and a number) as false without calling __eq,
+ * and `if x then` is true for any userdata.  The message says so, since
+ * whoever meets this error may have written those too. */
 static int branch_error(lua_State *L, const char *op, const char *fn)
 {
   const char *what = NULL;
@@ -145,7 +149,10 @@ static int branch_error(lua_State *L, const char *op, const char *fn)
     what = lua_tostring(L, -1);
   return luaL_error(L, "branch on a symbolic value ('%s' on an expression)%s%s:"
                     " an expression has no truth value; use "
-                    "dm.select(dm.%s(a, b), x, y) for a piecewise definition",
+                    "dm.select(dm.%s(a, b), x, y) for a piecewise definition "
+                    "(beware: 'x == 0' with a number is silently false and "
+                    "'if x then' silently true while tracing; they need "
+                    "dm.select too)",
                     op, what ? " in " : "", what ? what : "", fn);
 }
 

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/numfmt.h"
 #include "lua/l_integ.h"
 
 #define TABBOX_MT "dmech.tableaubox"
@@ -198,10 +199,13 @@ static void set_option(lua_State *L, const dm_option_desc *d, const char *fname,
        !(t == LUA_TNUMBER && lua_tonumber(L, -1) == floor(lua_tonumber(L, -1)))) ||
       (d->kind == DM_OPT_DOUBLE && t != LUA_TNUMBER) ||
       (d->kind == DM_OPT_BOOL && t != LUA_TBOOLEAN) ||
-      (d->kind == DM_OPT_STRING && t != LUA_TSTRING))
+      (d->kind == DM_OPT_STRING && t != LUA_TSTRING)) {
+    char got[DM_NUM_BUFSIZE];
+    if (t == LUA_TNUMBER)
+      dm_num_format(got, sizeof got, lua_tonumber(L, -1));
     luaL_error(L, "%s: option '%s' must be %s, got %s", fname, d->name, kinds[d->kind],
-               t == LUA_TNUMBER && d->kind == DM_OPT_INT ? "a non-integer number"
-                                                         : luaL_typename(L, -1));
+               t == LUA_TNUMBER && d->kind == DM_OPT_INT ? got : luaL_typename(L, -1));
+  }
   if (d->kind == DM_OPT_STRING) {
     st = dm_integ_opts_set_string(opt, d->name, lua_tostring(L, -1), &e);
   } else {

@@ -66,6 +66,10 @@ static size_t read_cyclic(lua_State *L, const dm_lsystem *ls, int o, size_t *cyc
       luaL_error(L, "dm.routh: no coordinate '%s' in system '%s' (coordinates: %s)", bad,
                  ls->sys.name, dm_lsystem_names(L, ls->sys.coords, ls->n));
     }
+    for (size_t j = 0; j < r; j++)
+      if (cyc[j] == (size_t)i)
+        luaL_error(L, "dm.routh: cyclic coordinate '%s' is listed twice (cyclic[%d] and "
+                   "cyclic[%d])", lua_tostring(L, -1), (int)j + 1, (int)k);
     cyc[r++] = (size_t)i;
     lua_pop(L, 1);
   }

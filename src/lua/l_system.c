@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/numfmt.h"
 #include "lua/l_system.h"
 #include "lua/l_expr.h"
 #include "expr/lagrangian.h"
@@ -150,6 +151,17 @@ long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg)
     luaL_error(L, "no coordinate '%s' in system '%s' (coordinates: %s)", name, ls->sys.name,
                dm_lsystem_names(L, ls->sys.coords, ls->sys.n));
   return i;
+}
+
+/* A NaN or infinite parameter would be blamed on the state much later
+ * ("Newton did not converge at step 1"): refuse it where it is given. */
+void dm_lsystem_checkfinite(lua_State *L, const char *what, const char *name, double x)
+{
+  char buf[DM_NUM_BUFSIZE];
+  if (!isfinite(x)) {
+    dm_num_format(buf, sizeof buf, x);
+    luaL_error(L, "%s: parameter '%s' must be a finite number, got %s", what, name, buf);
+  }
 }
 
 void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x)
@@ -309,6 +321,7 @@ static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
   for (k = 0; k < n; k++) {
     if (!is_ident(names[k]))
       luaL_error(L, "dm.system: parameter name '%s' must be letters, digits and _", names[k]);
+    dm_lsystem_checkfinite(L, "dm.system", names[k], vals[k]);
     for (size_t j = 0; j < k; j++)
       if (strcmp(names[j], names[k]) == 0)
         luaL_error(L, "dm.system: parameter '%s' is listed twice", names[k]);
@@ -382,6 +395,27 @@ static int native_mode(lua_State *L, int t)
   return mode;
 }
 
+/* A misspelt field (Lagrangian =, constraint =) was silently ignored. */
+static void check_fields(lua_State *L, int t)
+{
+  static const char *const known[] = {"name", "coords", "params", "L", "force",
+                                      "constraints", "native", NULL};
+  lua_pushnil(L);
+  while (lua_next(L, t) != 0) {
+    int i = 0;
+    lua_pop(L, 1);
+    if (lua_type(L, -1) == LUA_TSTRING)
+      for (; known[i] != NULL && strcmp(known[i], lua_tostring(L, -1)) != 0; i++)
+        ;
+    if (lua_type(L, -1) != LUA_TSTRING || known[i] == NULL) {
+      int str = lua_type(L, -1) == LUA_TSTRING;
+      const char *key = luaL_tolstring(L, -1, NULL);
+      luaL_error(L, "dm.system: unknown field %s%s%s (fields: name, coords, params, L, "
+                 "force, constraints, native)", str ? "'" : "[", key, str ? "'" : "]");
+    }
+  }
+}
+
 /* dm.system{name=, coords=, params=, L=, force=, constraints=, native=} */
 static int l_system(lua_State *L)
 {
@@ -394,6 +428,7 @@ static int l_system(lua_State *L)
   int args[3], s;
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
+  check_fields(L, 1);
   const char *name = dm_optstringfield(L, 1, "name", "system");
   dm_lsystem *ls = dm_lua_system_new(L);             /* 2 */
   coords = read_coords(L, 1, &n);
@@ -462,6 +497,12 @@ static int l_system(lua_State *L)
   sp.native = mode;
   if ((s = dm_lagrangian_compile(dm_lua_exprctx(L), &sp, &ls->sys, &e)) != DM_OK)
     return dm_lua_fail(L, "dm.system", s, &e);
+  if (m >= n)
+    return luaL_error(L, "dm.system: %d constraint%s on %d coordinate%s leave%s no motion "
+                      "(at most %d independent constraint%s)", (int)m, m == 1 ? "" : "s",
+                      (int)n, n == 1 ? "" : "s", m == 1 ? "s" : "", (int)n - 1,
+                      n == 2 ? "" : "s");
+
   ls->traced = 1;
   ls->sys.refresh = dm_lagrangian_refresh;     /* its separable mass follows the parameters */
   if (dm_lagrangian_stats_get(&ls->sys, &st) == DM_OK)

@@ -64,6 +64,8 @@ long dm_lua_system_coord(const dm_lsystem *ls, const char *name);
 long dm_lua_system_param(const dm_lsystem *ls, const char *name);
 /* Set parameter i to x: refreshes the mass of traced systems, bumps gen. */
 void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x);
+/* Raise "<what>: parameter '<name>' must be a finite number, got nan". */
+void dm_lsystem_checkfinite(lua_State *L, const char *what, const char *name, double x);
 
 /* Read n numbers for the system's coordinates from the value at idx: a vec,
  * a list of numbers, or a table keyed by coordinate names ({r = 2, z = 0.3};

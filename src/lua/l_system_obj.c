@@ -123,6 +123,7 @@ static int s_set(lua_State *L)
     if (lua_type(L, -1) != LUA_TNUMBER)
       return luaL_error(L, "set: parameter '%s' needs a number, got %s", lua_tostring(L, -2),
                         luaL_typename(L, -1));
+    dm_lsystem_checkfinite(L, "set", lua_tostring(L, -2), lua_tonumber(L, -1));
     lua_pop(L, 1);
   }
   lua_pushnil(L);
@@ -368,6 +369,7 @@ static int params_newindex(lua_State *L)
   if (lua_type(L, 3) != LUA_TNUMBER)
     return luaL_error(L, "parameter '%s' needs a number, got %s", ls->sys.params[i],
                       luaL_typename(L, 3));
+  dm_lsystem_checkfinite(L, "params", ls->sys.params[i], lua_tonumber(L, 3));
   dm_lua_system_setparam(L, ls, (size_t)i, lua_tonumber(L, 3));
   return 0;
 }

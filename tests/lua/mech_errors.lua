@@ -38,13 +38,13 @@ err("dm.integrator: option 'order' does not apply to method 'gauss'", "compositi
 err("dm.integrator: option 'tableau' does not apply to method 'lobatto'", "tableau without prk",
     integ{method = "lobatto", tableau = dm.tableau("lobatto", 3)})
 err("dm.integrator: option 'h' must be a number, got string", "h as a string", integ{h = "0.1"})
-err("dm.integrator: option 'stages' must be an integer, got a non%-integer number", "fractional stages", integ{stages = 2.5})
+err("dm.integrator: option 'stages' must be an integer, got 2.5", "fractional stages", integ{stages = 2.5})
 err("dm.integrator: option 'simplified' must be a boolean, got number", "boolean option", integ{simplified = 1})
 err("dm.integrator: option 'scheme' must be a string, got number", "string option",
     integ{method = "composition", scheme = 4})
 err("dm.integrator: option 'method' must be a string, got number", "method as a number", integ{method = 4})
 err("dm.integrator: option 'h' must be a finite non%-zero number", "h = 0", integ{h = 0})
-err("dm.integrator: option 'stages' = 21 out of range %(integer 0..20%)", "stages too large", integ{stages = 21})
+err("dm.integrator: option 'stages' = 21 out of range %(integer 1..20%)", "stages too large", integ{stages = 21})
 err("dm.integrator: lobatto: stages = 1 out of range 2..20", "Lobatto with one stage", integ{method = "lobatto", stages = 1})
 err("dm.integrator: option 'tol' = 0 out of range", "tol = 0", integ{tol = 0})
 err("dm.integrator: option 'maxiter' = 0 out of range", "maxiter = 0", integ{maxiter = 0})
