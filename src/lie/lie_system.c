@@ -57,13 +57,9 @@ static void factor_names(const dm_lie_group *F, char (*out)[24])
 
 /* every stored number named; a name seen before in an earlier factor gets
  * the suffix _<factor> */
-static char **make_gnames(const dm_lie_group *G)
+void dm_lie_coord_names(const dm_lie_group *G, char (*names)[DM_LIE_NAME_MAX])
 {
-  static char buf[DM_LIE_NQ_MAX][24];
-  char **names = calloc(G->nq + 1, sizeof *names);
   size_t f, nf = G->kind == DM_LIE_PRODUCT ? G->nfac : 1, i, k = 0;
-  if (names == NULL)
-    return NULL;
   for (f = 0; f < nf; f++) {
     const dm_lie_group *F = G->kind == DM_LIE_PRODUCT ? G->fac[f] : G;
     char nb[DM_LIE_NQ_MAX][24];
@@ -74,13 +70,28 @@ static char **make_gnames(const dm_lie_group *G)
       for (j = 0; j < k; j++)
         dup = dup || strcmp(names[j], nb[i]) == 0;
       if (dup)
-        snprintf(buf[k], 24, "%s_%zu", nb[i], f + 1);
+        snprintf(names[k], DM_LIE_NAME_MAX, "%.12s_%u", nb[i], (unsigned)(f + 1) % 100u);
       else
-        snprintf(buf[k], 24, "%s", nb[i]);
-      if ((names[k] = dupstr(buf[k])) == NULL)
-        return names;
+        snprintf(names[k], DM_LIE_NAME_MAX, "%s", nb[i]);
     }
   }
+}
+
+static char **make_gnames(const dm_lie_group *G)
+{
+  char (*buf)[DM_LIE_NAME_MAX] = malloc(G->nq * sizeof *buf);
+  char **names = calloc(G->nq + 1, sizeof *names);
+  size_t k;
+  if (names == NULL || buf == NULL) {
+    free(buf);
+    free(names);
+    return NULL;
+  }
+  dm_lie_coord_names(G, buf);
+  for (k = 0; k < G->nq; k++)
+    if ((names[k] = dupstr(buf[k])) == NULL)
+      break;
+  free(buf);
   return names;
 }
 

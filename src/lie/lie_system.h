@@ -100,6 +100,8 @@ const dm_lie_group *dm_lie_system_group(const dm_lie_system *S);
 int dm_lie_system_is_reduced(const dm_lie_system *S);
 /* Names of the stored numbers of g ("R11".."R33", "p1".."p3", "theta",
  * "x1".., factor names made unique), of mu ("mu1"..) and xi ("xi1"..). */
+#define DM_LIE_NAME_MAX 24
+void dm_lie_coord_names(const dm_lie_group *G, char (*names)[DM_LIE_NAME_MAX]);
 const char *const *dm_lie_system_gnames(const dm_lie_system *S);
 const char *const *dm_lie_system_munames(const dm_lie_system *S);
 const char *const *dm_lie_system_xinames(const dm_lie_system *S);

@@ -157,6 +157,8 @@ void dm_open_builtin(lua_State *L);     /* dm.systems catalog, with its C implem
 void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.order_estimate, dm.methods */
 void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
 void dm_open_lie(lua_State *L);         /* dm.lie: Lie groups, systems on groups (l_lie*.c) */
+/* dm.system{space = G, ...}: a system on a Lie group (l_lie_system.c) */
+int dm_lua_lie_system(lua_State *L);
 /* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
  * bindings whose objects make integrators (red:integrator). */
 int dm_lua_integrator(lua_State *L);

@@ -78,6 +78,11 @@ dm_lsystem *dm_linteg_checksystem(lua_State *L, int idx)
 /* dm.integrator(sys, {method=, h=, ...}) */
 int dm_lua_integrator(lua_State *L)
 {
+  if (luaL_getmetafield(L, 1, "__integrator") != LUA_TNIL) {  /* objects making their own */
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, 1);
+    return 1;
+  }
   dm_lsystem *ls = dm_linteg_checksystem(L, 1);
   const char *method;
   double h;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lua/l_lie.h"
+#include "lua/l_lie_sys.h"
 #include "lua/l_expr.h"
 
 /* {======================================================================
@@ -921,6 +922,8 @@ void dm_open_lie(lua_State *L)
   newclass_bound(L, DM_LIEGROUP_MT, "liegroup", "G.", group_funcs, gmeta);
   newclass_bound(L, DM_LIESPHERE_MT, "liesphere", "S.", sphere_funcs, smeta);
   dm_lua_open_lieelem(L);
+  dm_lua_open_liesys(L);
+  dm_lua_open_lieinteg(L);
   lua_newtable(L);
   dm_register(L, "dm.lie.", lie_funcs);
   lua_setfield(L, -2, "lie");

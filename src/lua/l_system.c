@@ -427,6 +427,9 @@ static int l_system(lua_State *L)
   size_t n, npar, m = 0;
   int args[3], s;
   luaL_checktype(L, 1, LUA_TTABLE);
+  if (lua_getfield(L, 1, "space") != LUA_TNIL)    /* a system on a Lie group */
+    return dm_lua_lie_system(L);
+  lua_pop(L, 1);
   lua_settop(L, 1);
   check_fields(L, 1);
   const char *name = dm_optstringfield(L, 1, "name", "system");
