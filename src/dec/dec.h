@@ -36,6 +36,18 @@
  *
  * Threads: complexes and geometries are read-only after _alloc and may be
  * shared by any number of threads; every function here is reentrant.
+ *
+ * Using a triangle mesh (n = 2) from other modules: vertices are 0..nsimp[0]-1
+ * with coordinates G->X (N per vertex); edge e is simp[1][2e] < simp[1][2e+1];
+ * triangle t is top[3t..3t+2] in its oriented order.  The edges of t are
+ * face[1][3t + j] for the local masks dm_dec_face_mask(2, 1, j) = {0,1},
+ * {0,2}, {1,2} over the sorted row simp[2][3t..]; row t of d[1] lists them
+ * with the induced signs (+1: the edge runs along t's orientation).  The
+ * triangles of an edge are the column of d[1] (dm_sparse_transpose); an
+ * edge with one triangle is a boundary edge (boundary[1][e]).  Lengths
+ * squared: G->len2[e]; areas G->vol[2][t]; angles follow from len2 (the
+ * cotangents are how geom.c gets the duals).  dm_dec_find(K, k, v) looks a
+ * simplex up by its vertices.
  */
 #ifndef DM_DEC_H
 #define DM_DEC_H

@@ -17,7 +17,6 @@ struct dm_dec_mg {
   int **diag;                    /* position of the diagonal in each row of A[l] */
   double **x, **b, **r;          /* per level */
   dm_sparse_chol *coarse;
-  double *full;                  /* n: residual on the finest level */
 };
 
 void dm_dec_mg_free(dm_dec_mg *M)
@@ -48,7 +47,6 @@ void dm_dec_mg_free(dm_dec_mg *M)
   free(M->b);
   free(M->r);
   free(M->freeidx);
-  free(M->full);
   dm_sparse_chol_free(M->coarse);
   free(M);
 }
@@ -78,9 +76,8 @@ dm_dec_mg *dm_dec_mg_alloc(int nlev, dm_sparse *const *P, const dm_sparse *S,
   M->b = calloc((size_t)nlev, sizeof *M->b);
   M->r = calloc((size_t)nlev, sizeof *M->r);
   M->freeidx = malloc(((size_t)M->n + 1) * sizeof *M->freeidx);
-  M->full = malloc(((size_t)M->n + 1) * sizeof *M->full);
   keep = malloc((size_t)M->n + 1);
-  if (!M->A || !M->P || !M->Pt || !M->diag || !M->x || !M->b || !M->r || !M->freeidx || !M->full || !keep)
+  if (!M->A || !M->P || !M->Pt || !M->diag || !M->x || !M->b || !M->r || !M->freeidx || !keep)
     goto nomem;
   for (i = 0; i < M->n; i++) {
     keep[i] = !(fixed != NULL && fixed[i]);
