@@ -199,7 +199,7 @@ int main(void)
     G = geom(m, &K);
     for (j = 0; j < 3; j++) {
       double d = 0;
-      snprintf(path, sizeof path, "%s/dec_sphere.%s", dir != NULL ? dir : ".", ext[j]);
+      snprintf(path, sizeof path, "%s/dec_sphere.%s", dir != NULL ? dir : "/tmp", ext[j]);
       tap_ok(dm_dec_write(path, K, G, &e) == DM_OK, "write %s", ext[j]);
       tap_ok(dm_dec_load(path, &K2, &G2, &e) == DM_OK, "load %s back", ext[j]);
       for (i = 0; K2 && i < K->nsimp[0] * 3; i++)
