@@ -54,13 +54,12 @@ dm.plot{ {function(th) local r = p / (1 + e * math.cos(th)) return r * math.cos(
           range = {0, 2 * math.pi}, samples = 400, title = "r = p / (1 + e cos θ)", with = "lines lw 2"},
          {{0}, {0}, with = "points pt 7 ps 1.5", title = "focus"},
          title = "Kepler ellipse, e = 0.6", xlabel = "x", ylabel = "y", aspect = "equal", grid = true,
-         key = "bottom right",
          output = out("gallery_curve.png"), size = {640, 480} }
 
 -- 2. a 3-D orbit: three columns give splot
 dm.plot{ {orbit, "x", "y", "z", title = "J2 orbit"},
          title = "Satellite around an oblate planet (J2 = 0.05)", xlabel = "x", ylabel = "y", zlabel = "z",
-         view = {65, 30}, output = out("gallery_orbit3d.png"), size = {800, 600} }
+         aspect = "equal", view = {65, 30}, output = out("gallery_orbit3d.png"), size = {800, 600} }
 
 -- 3. reduced beside unreduced: a 1x2 multiplot
 dm.plot{ {{orbit, "x", "y", title = "unreduced: (x, y)"}, title = "orbital plane", xlabel = "x", ylabel = "y",

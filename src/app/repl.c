@@ -572,10 +572,23 @@ static void bare_help(lua_State *L)
   lua_settop(L, 0);
 }
 
+/* dm.config.interactive = on: libraries that report what they did (dm.plot
+ * writing a file) do it at the prompt only. */
+static void set_config_interactive(lua_State *L, int on)
+{
+  int top = lua_gettop(L);
+  if (lua_getglobal(L, "dm") == LUA_TTABLE && lua_getfield(L, -1, "config") == LUA_TTABLE) {
+    lua_pushboolean(L, on);
+    lua_setfield(L, -2, "interactive");
+  }
+  lua_settop(L, top);
+}
+
 void dm_repl(lua_State *L)
 {
   int status, expr = 0, quiet = 0;
   dm_set_interactive(L, 1);
+  set_config_interactive(L, 1);
 #ifdef HAVE_READLINE
   use_readline = isatty(STDIN_FILENO) && open_sigpipe() == 0;
   if (use_readline) {
@@ -617,6 +630,7 @@ void dm_repl(lua_State *L)
   }
   lua_settop(L, 0);
   dm_set_interactive(L, 0);
+  set_config_interactive(L, 0);
   if (use_readline || isatty(STDIN_FILENO))
     fputs("\n", stdout);
   fflush(stdout);

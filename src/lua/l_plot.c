@@ -131,18 +131,32 @@ static int l_figure(lua_State *L) { return forward(L, "figure"); }
 
 static const dm_reg plot_funcs[] = {
   {"plot", l_plot,
-   "dm.plot{series..., title=, xlabel=, ylabel=, zlabel=, xrange=, yrange=, "
-   "layout=\"r,c\", output=\"f.png|svg|pdf\", size={w,h}, terminal=}",
-   "Plot series ({x, y[, z], with=, title=}, {obj, \"colx\", \"coly\"[, \"colz\"]} "
-   "for any obj with :column(name), or {f, range={a,b}}) with gnuplot; three "
-   "columns give a 3-D plot, layout a grid of panels, output a finished file."},
+   "dm.plot{series..., options...}",
+   "Plot series with gnuplot: {x, y[, z]} (tables or vecs), {obj, \"colx\", \"coly\"[, \"colz\"]} "
+   "for any obj with :column(name) (trajectories), {f, range = {a, b}, samples = 500} for "
+   "f(t) -> y | x, y | x, y, z; series options with = \"lines\" (a gnuplot style), legend = "
+   "\"text\" (the key entry; title is the same), range, samples.  Three columns make a 3-D "
+   "plot; layout = \"rows,cols\" makes every element a panel (a series, or a table of series "
+   "with its own panel options; a single-series panel's title is the panel's title).  By "
+   "default axes are labelled with the column names, the key goes to a corner free of data "
+   "(or outside), configuration-space orbits (coordinate columns on every axis) get equal "
+   "aspect, and values <= 0 on a log axis are left out; output writes the file."},
   {"figure", l_figure, "dm.figure{options..., series...} -> figure",
    "A figure that keeps its series for live updates (:add, :append, "
-   ":refresh), saving (:save) and closing (:close, or a <close> variable)."},
+   ":refresh), saving (:save) and closing (:close, or a <close> variable); it takes "
+   "dm.plot's series and options."},
   {"gnuplot", l_gnuplot, "dm.gnuplot(\"command\") -> string",
    "Send a raw command to the session's gnuplot and return what it printed; "
    "its complaints become errors."},
   {NULL, NULL, NULL, NULL}
+};
+
+/* The options of dm.plot and dm.figure (plot.lua reads this list: the
+ * first five are plot-wide, the others also panel options). */
+static const char *const plot_keys[] = {
+  "layout", "output", "size", "terminal", "enhanced",
+  "title", "xlabel", "ylabel", "zlabel", "xrange", "yrange", "zrange", "logscale", "grid",
+  "key", "aspect", "view", "with", "commands", NULL
 };
 
 /* Documented here so help() knows them before plot.lua is loaded;
@@ -399,6 +413,15 @@ static int gp_program(lua_State *L)
   return 0;
 }
 
+static int gp_log_to(lua_State *L)
+{
+  const char *p = lua_toboolean(L, 1) ? dm_checkcstring(L, 1) : NULL;
+  dm_err e;
+  if (dm_gp_set_log(session(L), p, &e) != DM_OK)
+    return raise(L, "dm._gp.log", e.status, &e);
+  return 0;
+}
+
 static const dm_reg gp_funcs[] = {
   {"begin", gp_begin, "dm._gp.begin([what])",
    "Start a plot transaction, (re)starting gnuplot when needed."},
@@ -429,6 +452,8 @@ static const dm_reg gp_funcs[] = {
    "Get or set how long gnuplot may stay silent before it is declared hung."},
   {"program", gp_program, "dm._gp.program(path | false)",
    "Use this gnuplot program from the next start (false: $DMECH_GNUPLOT or gnuplot)."},
+  {"log", gp_log_to, "dm._gp.log(file | false)",
+   "Record every command sent to gnuplot in a file (as $DMECH_GNUPLOT_LOG does); false stops."},
   {NULL, NULL, NULL, NULL}
 };
 
@@ -442,6 +467,8 @@ void dm_open_plot(lua_State *L)
   lua_setfield(L, -2, "__gc");
   lua_pop(L, 1);
   dm_register(L, "dm.", plot_funcs);
+  dm_doc_options(L, "dm.plot", plot_keys);
+  dm_doc_options(L, "dm.figure", plot_keys);
   lua_newtable(L);
   dm_register(L, "dm._gp.", gp_funcs);
   lua_setfield(L, -2, "_gp");
