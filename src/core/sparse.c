@@ -8,6 +8,17 @@
 #include <string.h>
 #include <suitesparse/klu.h>
 
+int dm_linear_mode_parse(const char *name)
+{
+  if (name == NULL || name[0] == '\0' || strcmp(name, "auto") == 0)
+    return DM_LINEAR_AUTO;
+  if (strcmp(name, "dense") == 0)
+    return DM_LINEAR_DENSE;
+  if (strcmp(name, "sparse") == 0)
+    return DM_LINEAR_SPARSE;
+  return -1;
+}
+
 int dm_csr_alloc(dm_csr *p, size_t nrow, size_t ncol, size_t nnz)
 {
   memset(p, 0, sizeof *p);

@@ -38,6 +38,12 @@
 
 #include "core/status.h"
 
+/* How the linear systems of a solver are solved (the integrators' option
+ * "linear"): dense LU, sparse LU, or chosen by size and sparsity. */
+enum dm_linear_mode { DM_LINEAR_AUTO = 0, DM_LINEAR_DENSE, DM_LINEAR_SPARSE };
+/* "auto" (also NULL or ""), "dense", "sparse"; -1 for another name. */
+int dm_linear_mode_parse(const char *name);
+
 typedef struct dm_csr {
   size_t nrow, ncol, nnz;
   size_t *rowptr;           /* nrow + 1 */

@@ -14,7 +14,8 @@
  * loaded where it is needed.  Each output is stored to its destinations
  * as soon as it is computed.
  *
- * Entry points (in the last unit): unmapped, dm_native_eval(in, par, out)
+ * Entry points (in the last unit, the only one for a tape of one unit of
+ * chunks): unmapped, dm_native_eval(in, par, out)
  * with output k at out[k]; mapped, dm_native_scatter(in, par, out, mask,
  * work): input i from in[arr][elem], outputs to out[arr][elem] for the
  * arrays in mask (the others into work, which needs dm_native__work
@@ -543,8 +544,11 @@ int dm_native__emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
   E.nst = nst - nnov;
   if (schedule(&E) != 0 || plan(&E) != 0)
     goto done;
+  /* one unit of chunks: the entry point goes with them (one compiler run
+   * that also links); more: a unit of its own */
   size_t nunit = (E.nchunk + per_unit - 1) / per_unit;
-  out->n = nunit + 1;
+  int alone = nunit != 1;
+  out->n = nunit + (size_t)alone;
   out->src = calloc(out->n, sizeof *out->src);
   if (out->src == NULL)
     goto done;
@@ -561,7 +565,13 @@ int dm_native__emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
   }
   {
     sbuf b = { NULL, 0, 0, 0 };
-    sb_printf(&b, "%s", prelude);
+    if (alone)
+      sb_printf(&b, "%s", prelude);
+    else {
+      b.s = out->src[0];
+      b.len = b.cap = strlen(b.s);
+      out->src[0] = NULL;
+    }
     store *save = E.st;
     size_t savn = E.nst;
     E.st += nst - nnov;                 /* the entry stores the NOVAL ones */
@@ -573,7 +583,7 @@ int dm_native__emit(const dm_tape *t, const dm_native_map *inmap, size_t nmap,
       free(b.s);
       goto done;
     }
-    out->src[nunit] = b.s;
+    out->src[out->n - 1] = b.s;
   }
   out->nslot = E.nslot;
   s = DM_OK;

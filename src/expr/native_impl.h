@@ -10,6 +10,8 @@
  * then linked. */
 #define CC_UNIT_FLAGS "-c -fPIC -ffp-contract=off -fno-math-errno"
 #define CC_LINK_FLAGS "-shared"
+/* One unit: compiled and linked by one run. */
+#define CC_ONE_FLAGS "-fPIC -shared -ffp-contract=off -fno-math-errno"
 
 /* The source of a tape as translation units (native_emit.c); the last one
  * holds the entry point.  nslot: doubles the entry point keeps on its

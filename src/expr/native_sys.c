@@ -599,10 +599,41 @@ static void *unit_worker(void *arg)
   return NULL;
 }
 
+/* One unit: compiled and linked by one compiler run. */
+static int build_one(char **ccargv, int ncc, const char *dir, const char *src,
+                     const char *opt, char *obj, size_t objsize, dm_err *err)
+{
+  char cpath[4200], flags[] = CC_ONE_FLAGS, optc[64], *argv[64], msg[2048];
+  int a = 0, status;
+  snprintf(cpath, sizeof cpath, "%s/u0.c", dir);
+  snprintf(obj, objsize, "%s/f.so", dir);
+  if (write_file(cpath, src, strlen(src)) != 0)
+    return dm_err_set(err, DM_EIO, "native: cannot write %s: %s", cpath, strerror(errno));
+  for (int i = 0; i < ncc && a < 40; i++)
+    argv[a++] = ccargv[i];
+  a += dm_native__cc_words(flags, argv + a, 16);
+  snprintf(optc, sizeof optc, "%s", opt);
+  a += dm_native__cc_words(optc, argv + a, 4);
+  argv[a++] = "-o";
+  argv[a++] = obj;
+  argv[a++] = cpath;
+  argv[a++] = "-lm";
+  argv[a] = NULL;
+  int s = run(argv, msg, sizeof msg, &status, err);
+  if (s != DM_OK)
+    return s;
+  if (status != 0)
+    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s", ccargv[0], status,
+                      msg);
+  return DM_OK;
+}
+
 int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const *src,
                            size_t n, const char *opt, int par, char *obj,
                            size_t objsize, dm_err *err)
 {
+  if (n == 1)
+    return build_one(ccargv, ncc, dir, src[0], opt, obj, objsize, err);
   unit_job J;
   memset(&J, 0, sizeof J);
   J.ccargv = ccargv;

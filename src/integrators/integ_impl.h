@@ -75,6 +75,11 @@ typedef struct dm_legendre_ws {
   size_t *mperm;
   int mass_state;                     /* 0: not factored, 1: unit, 2: LU */
   void *work;
+  /* large systems (more than 256 coordinates, with a pattern): no n x n
+   * array; d2L/dv2 on its pattern, solved by sparse LU */
+  int large;
+  double *sLvv;                       /* vv.nnz */
+  dm_splu *lu;                        /* made at the first velocity solve */
 } dm_legendre_ws;
 
 dm_legendre_ws *dm_legendre_alloc(const dm_system *sys);
@@ -88,7 +93,8 @@ int dm_legendre_energy(dm_legendre_ws *w, const double *q, const double *v,
 /* Hamiltonian vector field qdot = v(q, p), pdot = Lq + F (warm-started). */
 int dm_legendre_field(dm_legendre_ws *w, const double *q, const double *p,
                       double *qdot, double *pdot, dm_err *e);
-/* Its Jacobian d(qdot, pdot)/d(q, p), 2n x 2n row-major. */
+/* Its Jacobian d(qdot, pdot)/d(q, p), 2n x 2n row-major (DM_EUNSUP for a
+ * large system). */
 int dm_legendre_field_jac(dm_legendre_ws *w, const double *q, const double *p,
                           double *Jm, dm_err *e);
 
@@ -101,7 +107,7 @@ typedef struct dm_prk dm_prk;
  * Gauss with s >= 2 on a constrained system is DM_EUNSUP (see
  * prk_constrained.c).  On error *out is NULL. */
 int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
-                 int maxiter, int explicit_sv, dm_prk **out, dm_err *e);
+                 int maxiter, int explicit_sv, int linear, dm_prk **out, dm_err *e);
 void dm_prk_free(dm_prk *P);
 void dm_prk_reset(dm_prk *P);
 int dm_prk_is_explicit(const dm_prk *P);

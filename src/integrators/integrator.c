@@ -32,6 +32,8 @@ const dm_option_desc dm_integ_options[] = {
   {"adaptive", DM_OPT_BOOL, OPT(adaptive), 0, 1, "gsl:*: adaptive steps inside each h"},
   {"epsabs", DM_OPT_DOUBLE, OPT(epsabs), 0, 1, "gsl:*: absolute tolerance (default 1e-10)"},
   {"epsrel", DM_OPT_DOUBLE, OPT(epsrel), 0, 1, "gsl:*: relative tolerance (default 1e-10)"},
+  {"linear", DM_OPT_STRING, OPT(linear), 0, 0,
+   "Newton matrices: dense LU, sparse LU (KLU) or auto (default: sparse for large sparse systems)"},
   {NULL, 0, 0, 0, 0, 0, NULL}
 };
 #undef OPT
@@ -47,6 +49,7 @@ void dm_integ_opts_init(dm_integ_opts *o)
   o->explicit_sv = 1;
   o->epsabs = 1e-10;
   o->epsrel = 1e-10;
+  strcpy(o->linear, "auto");
 }
 
 const dm_option_desc *dm_integ_option_find(const char *name)
@@ -240,9 +243,13 @@ void dm_integrator_free(dm_integrator *I)
 
 void dm_integrator_reset(dm_integrator *I)
 {
+  int linear = I->stats.linear;          /* facts of the setup, not counters */
+  size_t nnz = I->stats.nnz;
   if (I->type->reset)
     I->type->reset(I);
   memset(&I->stats, 0, sizeof I->stats);
+  I->stats.linear = linear;
+  I->stats.nnz = nnz;
 }
 
 static int finite_vec(const double *x, size_t n)

@@ -65,6 +65,7 @@ typedef struct dm_integ_opts {
   int adaptive;        /* gsl: adaptive steps inside each h */
   double epsabs, epsrel;         /* gsl adaptive tolerances */
   const dm_tableau *tableau;     /* prk: user tableau (copied by new()) */
+  char linear[DM_INTEG_STRMAX];  /* Newton matrices: auto (default), dense, sparse */
 } dm_integ_opts;
 
 enum dm_opt_kind { DM_OPT_INT, DM_OPT_DOUBLE, DM_OPT_BOOL, DM_OPT_STRING };
@@ -149,6 +150,9 @@ typedef struct dm_integ_stats {
   double tol;           /* the tolerance it was compared with */
   long steps;           /* steps taken since new() or reset */
   long iters_total;
+  int linear;           /* the Newton matrices: DM_LINEAR_DENSE or _SPARSE (core/sparse.h;
+                           0 for explicit methods) */
+  size_t nnz;           /* entries of a sparse Newton matrix */
 } dm_integ_stats;
 
 struct dm_integrator {

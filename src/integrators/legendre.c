@@ -11,6 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* More coordinates than this (and a pattern): no n x n arrays. */
+#define DM_LEG_DENSE_MAX 256
+
 dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
 {
   size_t n = sys->n;
@@ -18,9 +21,10 @@ dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
   double *d;
   if (w == NULL)
     return NULL;
+  w->large = n > DM_LEG_DENSE_MAX && sys->pattern != NULL;
   /* Lq Lv F r vguess: 5n; Lvv Lvq Lqq Fq Fv A: 6 n*n; T: 2 n*n; Mcopy Mlu:
-   * 2 n*n */
-  d = calloc(5 * n + 10 * n * n, sizeof(double));
+   * 2 n*n -- or, large, the values of Lvv on its pattern */
+  d = calloc(5 * n + (w->large ? sys->pattern->vv.nnz + 1 : 10 * n * n), sizeof(double));
   w->perm = calloc(2 * n, sizeof(size_t));
   w->work = sys->work_size ? malloc(sys->work_size) : NULL;
   if (d == NULL || w->perm == NULL || (sys->work_size && w->work == NULL)) {
@@ -40,6 +44,10 @@ dm_legendre_ws *dm_legendre_alloc(const dm_system *sys)
   w->F = d + 2 * n;
   w->r = d + 3 * n;
   w->vguess = d + 4 * n;
+  if (w->large) {
+    w->sLvv = d + 5 * n;
+    return w;
+  }
   w->Lvv = d + 5 * n;
   w->Lvq = w->Lvv + n * n;
   w->Lqq = w->Lvq + n * n;
@@ -59,6 +67,7 @@ void dm_legendre_free(dm_legendre_ws *w)
   free(w->Lq);
   free(w->perm);
   free(w->work);
+  dm_splu_free(w->lu);
   free(w);
 }
 
@@ -104,6 +113,15 @@ static int separable_velocity(dm_legendre_ws *w, const double *p, double *v, dm_
 {
   const double *M = w->sys->mass;
   size_t n = w->n, nn = n * n, i;
+  if (M == NULL) {                /* large: the diagonal mass on the pattern */
+    const double *m = w->sys->pattern->mass;
+    for (i = 0; i < n; i++)
+      v[i] = p[i] / m[i];
+    for (i = 0; i < n; i++)
+      if (!isfinite(v[i]))
+        return dm_err_set(e, DM_EDOM, "velocity solve produced a non-finite value");
+    return DM_OK;
+  }
   if (w->mass_state == 0 || !dm_same(M, w->Mcopy, nn)) {
     int unit = 1;
     dm_vcopy(w->Mcopy, M, nn);
@@ -129,6 +147,61 @@ static int separable_velocity(dm_legendre_ws *w, const double *p, double *v, dm_
   return DM_OK;
 }
 
+/* A separable system whose mass is known: dense, or diagonal on the
+ * pattern of a large one. */
+static int separable(const dm_legendre_ws *w)
+{
+  const dm_system *s = w->sys;
+  return (s->flags & DM_SYS_SEPARABLE) &&
+         (s->mass != NULL ||
+          (w->large && s->pattern->mass != NULL && s->pattern->vv.nnz == s->n));
+}
+
+/* Newton on Lv(q, v) = p for a large system: d2L/dv2 on its pattern,
+ * sparse LU (analysed at the first call). */
+static int large_velocity(dm_legendre_ws *w, const double *q, const double *p, double *v,
+                          int guess, dm_err *e)
+{
+  size_t n = w->n, i;
+  const dm_csr *vv = &w->sys->pattern->vv;
+  dm_lag_out o = {0, w->Lq, w->Lv, w->sLvv, NULL, NULL};
+  int mech = (w->sys->flags & (DM_SYS_MECHANICAL | DM_SYS_SEPARABLE)) != 0;
+  double d = HUGE_VAL;
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st;
+  if (w->lu == NULL && (st = dm_splu_alloc(vv, &w->lu, e)) != DM_OK)
+    return st;
+  if (!guess)
+    memset(v, 0, n * sizeof(double));
+  for (it = 0; it < w->maxiter; it++) {
+    double vs, ls;
+    st = dm_eval_lag(w->sys, q, v, DM_LAG_V | DM_LAG_VV | DM_LAG_SPARSE, &o, w->work, e);
+    if (st != DM_OK)
+      return st;
+    for (i = 0; i < n; i++)
+      w->r[i] = w->Lv[i] - p[i];
+    st = dm_splu_factor(w->lu, w->sLvv, NULL);
+    if (st == DM_ESINGULAR)
+      return singular_lvv(w->sys, q, v, e);
+    if (st != DM_OK)
+      return dm_err_set(e, st == DM_ENOMEM ? DM_ENOMEM : DM_EDOM,
+                        st == DM_ENOMEM ? "out of memory" : "non-finite d2L/dv2 in the velocity solve");
+    dm_splu_solve(w->lu, w->r, 1, NULL);
+    for (i = 0; i < n; i++)
+      v[i] -= w->r[i];
+    ls = dm_norm_inf(w->sLvv, vv->nnz);
+    vs = fmax(dm_norm_inf(v, n), dm_norm_inf(p, n) / (ls > 0 ? ls : 1.0));
+    d = dm_norm_inf(w->r, n) / (vs > 0 ? vs : 1.0);
+    if (!isfinite(d))
+      return dm_err_set(e, DM_EDOM, "velocity solve produced a non-finite value");
+    if (mech || dm_newton_done(&stop, d, w->tol))
+      return DM_OK;
+  }
+  return dm_err_set(e, DM_ENOCONV,
+                    "velocity from momentum (Newton on dL/dv = p) did not converge: "
+                    "relative update %.3g after %d iterations", d, it);
+}
+
 /* Newton on Lv(q, v) = p.  A mechanical L (linear Legendre map) needs one
  * iteration from any guess; a separable one none (v = M^{-1} p). */
 int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
@@ -140,8 +213,10 @@ int dm_legendre_velocity(dm_legendre_ws *w, const double *q, const double *p,
   double d = HUGE_VAL;
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
   int it, st;
-  if ((w->sys->flags & DM_SYS_SEPARABLE) && w->sys->mass != NULL)
+  if (separable(w))
     return separable_velocity(w, p, v, e);
+  if (w->large)
+    return large_velocity(w, q, p, v, guess, e);
   if (!guess)
     memset(v, 0, n * sizeof(double));
   for (it = 0; it < w->maxiter; it++) {
@@ -178,7 +253,7 @@ int dm_legendre_field(dm_legendre_ws *w, const double *q, const double *p,
   size_t n = w->n, i;
   dm_lag_out o = {0, w->Lq, w->Lv, w->Lvv, w->Lvq, w->Lqq};
   int st;
-  if ((w->sys->flags & DM_SYS_SEPARABLE) && w->sys->mass != NULL && qdot != p && pdot != q) {
+  if (separable(w) && qdot != p && pdot != q) {
     /* qdot = M^{-1} p, pdot = Lq(q) (+ F) straight into the outputs */
     if ((st = separable_velocity(w, p, qdot, e)) != DM_OK)
       return st;
@@ -220,6 +295,9 @@ int dm_legendre_field_jac(dm_legendre_ws *w, const double *q, const double *p,
   const double *v = w->vguess;
   double *X = w->T;     /* n x 2n: Lvv^{-1} [-Lvq | I] */
   int st;
+  if (w->large)
+    return dm_err_set(e, DM_EUNSUP, "the Jacobian of the Hamiltonian vector field is not "
+                      "available for systems of more than %d coordinates", DM_LEG_DENSE_MAX);
   if ((st = dm_legendre_velocity(w, q, p, w->vguess, w->have_guess, e)) != DM_OK)
     return st;
   w->have_guess = 1;

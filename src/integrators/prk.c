@@ -5,7 +5,8 @@
 #include <config.h>
 #include "integrators/integ_impl.h"
 
-static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", "simplified", NULL};
+static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", "simplified", "linear",
+                                          NULL};
 
 static int prk_alloc(dm_integrator *I, dm_err *e)
 {

@@ -211,7 +211,7 @@ int dm_prk_constr_assemble(dm_prk *P, double h, const double *q0, int jac, dm_er
   if ((st = dm_eval_constr(P->sys, q1, DM_CONSTR_G | DM_CONSTR_DG, g1, G1, NULL, P->work, e)) != DM_OK)
     return st;
   dm_prk_constr_terms(P->tab, n, m, P->nK, P->K, h, P->X, P->g, P->G, P->Hc, P->R,
-                      jac ? P->Jm : NULL);
+                      jac && !P->sparse ? P->Jm : NULL);
   return DM_OK;
 }
 

@@ -47,12 +47,37 @@ static size_t nunk(const dm_prk *P, int mode)
   return mode == DM_PRK_CSTEP ? P->sn + P->nK * P->m + P->m : P->sn;
 }
 
+/* Dense or sparse Newton matrices (linear = DM_LINEAR_AUTO): dense up to
+ * DM_PRK_SPARSE_MIN unknowns and whenever the system has no pattern or a
+ * stage block would be more than a quarter full; sparse above (or when
+ * the dense matrix would not fit comfortably: DM_PRK_DENSE_MAX unknowns).
+ * See doc/scale.md for the measurements behind the numbers. */
+#define DM_PRK_SPARSE_MIN 48
+#define DM_PRK_DENSE_MAX 2048
+
+static int want_sparse(const dm_system *sys, size_t s, size_t N, int linear)
+{
+  if (linear != DM_LINEAR_AUTO)
+    return linear == DM_LINEAR_SPARSE;
+  const dm_sys_pattern *p = sys->pattern;
+  size_t n = sys->n;
+  if (N <= DM_PRK_SPARSE_MIN)
+    return 0;
+  if (p == NULL)
+    return N > DM_PRK_DENSE_MAX;
+  double nnz = (double)(p->vv.nnz + 2 * p->vq.nnz + p->qq.nnz + p->fq.nnz + p->fv.nnz);
+  if (sys->m > 0)
+    nnz = (double)n * (double)n;       /* curvature terms fill the blocks */
+  (void)s;
+  return N > DM_PRK_DENSE_MAX || nnz <= 0.25 * (double)n * (double)n;
+}
+
 int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
-                 int maxiter, int explicit_sv, dm_prk **out, dm_err *e)
+                 int maxiter, int explicit_sv, int linear, dm_prk **out, dm_err *e)
 {
   dm_prk *P = calloc(1, sizeof *P);
   size_t n = sys->n, s = t->s, m = sys->m, nn = n * n, sn = s * n, i, j, tot;
-  size_t extra;
+  size_t extra, mat, stg, rhs;
   double *d;
   int st;
   *out = NULL;
@@ -65,7 +90,8 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
   P->sn = sn;
   P->nn = nn;
   P->forced = sys->force != NULL;
-  P->sep = (sys->flags & DM_SYS_SEPARABLE) && sys->mass != NULL && !P->forced;
+  P->sep = (sys->flags & DM_SYS_SEPARABLE) && !P->forced &&
+           (sys->mass != NULL || (sys->pattern != NULL && sys->pattern->mass != NULL));
   P->tol = tol;
   P->maxiter = maxiter;
   P->simplified = 1;
@@ -81,9 +107,18 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
   }
   extra = P->nK * m + m;
   P->Nmax = sn + extra;
-  tot = P->Nmax * P->Nmax + 3 * P->Nmax + 5 * sn + 7 * s * nn + s
-        + (s + 2) * (m + m * n + m * nn) + 6 * n + P->Nmax * 2 * n
-        + sn + P->Nmax + 2 * n + s * s + 2 * n + nn + n;
+  P->sparse = want_sparse(sys, s, P->Nmax, linear);
+  P->large = P->sparse && m == 0 && sys->pattern != NULL;
+  /* the dense Newton matrix, the n x n stage arrays, the step Jacobian's
+   * right-hand sides: only what the mode needs (a large system has none) */
+  mat = !P->sparse ? P->Nmax * P->Nmax
+        : m > 0 ? (n + m) * (n + m)      /* the momentum projection's matrix */
+        : 0;
+  stg = P->large ? 0 : 7 * s * nn;
+  rhs = P->large ? P->Nmax : P->Nmax * 2 * n;
+  tot = mat + 3 * P->Nmax + 5 * sn + stg + s
+        + (s + 2) * (m + m * n + m * nn) + 6 * n + rhs
+        + sn + P->Nmax + 2 * n + s * s + 2 * n + n + n;
   d = calloc(tot, sizeof(double));
   P->perm = calloc(P->Nmax, sizeof(size_t));
   P->work = sys->work_size ? malloc(sys->work_size) : NULL;
@@ -100,27 +135,32 @@ int dm_prk_alloc(const dm_system *sys, const dm_tableau *t, double tol,
     dm_prk_free(P);
     return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
   }
-#define TAKE(ptr, cnt) do { (ptr) = d; d += (cnt); } while (0)
-  TAKE(P->Jm, P->Nmax * P->Nmax);
+  P->block = d;
+#define TAKE(ptr, cnt) do { (ptr) = (cnt) > 0 ? d : NULL; d += (cnt); } while (0)
+  TAKE(P->Jm, mat);
   TAKE(P->R, P->Nmax);
   TAKE(P->X, P->Nmax);
   TAKE(P->hx, P->Nmax);
   TAKE(P->Q, sn); TAKE(P->Lq, sn); TAKE(P->Lv, sn); TAKE(P->W, sn); TAKE(P->F, sn);
-  TAKE(P->Lvv, s * nn); TAKE(P->Lvq, s * nn); TAKE(P->Lqq, s * nn);
-  TAKE(P->Fq, s * nn); TAKE(P->Fv, s * nn); TAKE(P->D, s * nn); TAKE(P->Bm, s * nn);
+  TAKE(P->Lvv, stg / 7); TAKE(P->Lvq, stg / 7); TAKE(P->Lqq, stg / 7);
+  TAKE(P->Fq, stg / 7); TAKE(P->Fv, stg / 7); TAKE(P->D, stg / 7); TAKE(P->Bm, stg / 7);
   TAKE(P->Lval, s);
   TAKE(P->g, (s + 2) * m); TAKE(P->G, (s + 2) * m * n); TAKE(P->Hc, (s + 2) * m * nn);
   TAKE(P->q1w, n); TAKE(P->p1w, n); TAKE(P->v1w, n); TAKE(P->dq, n); TAKE(P->dp, n);
   TAKE(P->tmp, n);
-  TAKE(P->rhs, P->Nmax * 2 * n);
+  TAKE(P->rhs, rhs);
   TAKE(P->hV, sn); TAKE(P->hq1, n); TAKE(P->hp1, n); TAKE(P->E, s * s);
-  TAKE(P->cq, n); TAKE(P->cp, n); TAKE(P->Minv, nn); TAKE(P->svf, n);
+  TAKE(P->cq, n); TAKE(P->cp, n); TAKE(P->Mdiag, n); TAKE(P->svf, n);
 #undef TAKE
   P->distinct_nodes = 1;
   for (i = 0; i < s; i++)
     for (j = 0; j < i; j++)
       if (fabs(t->c[i] - t->c[j]) < 1e-8)
         P->distinct_nodes = 0;
+  if (P->sparse && (st = dm_prk_sparse_setup(P, P->large, e)) != DM_OK) {
+    dm_prk_free(P);
+    return st;
+  }
   if (explicit_sv && (st = dm_prk_verlet_setup(P, e)) != DM_OK) {
     dm_prk_free(P);
     return st;
@@ -133,7 +173,9 @@ void dm_prk_free(dm_prk *P)
 {
   if (P == NULL)
     return;
-  free(P->Jm);
+  free(P->block);
+  free(P->Minv);
+  dm_prk_sparse_free(P->sp);
   free(P->perm);
   free(P->work);
   dm_legendre_free(P->leg);
@@ -156,9 +198,22 @@ int dm_prk_is_explicit(const dm_prk *P)
   return P->explicit_sv;
 }
 
+static int eval_dense(dm_prk *P, size_t i, int jac, int want_L, dm_err *e);
+
 /* Evaluate L (and the force) at stage i: gradients always, the value when
  * want_L, second derivatives when jac; W, D, Bm derived. */
 int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
+{
+  if (P->large)
+    return dm_prk_sparse_eval_stage(P, i, jac, want_L, e);
+  int st = eval_dense(P, i, jac, want_L, e);
+  if (st == DM_OK && jac && P->sparse)
+    dm_prk_sparse_gather(P, i);
+  return st;
+}
+
+/* dm_prk_eval_stage into the dense stage arrays. */
+static int eval_dense(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
 {
   size_t n = P->n, nn = P->nn, a, b;
   double *Qi = P->Q + i * n, *Vi = P->X + i * n;
@@ -180,7 +235,10 @@ int dm_prk_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e)
       double *Bm = P->Bm + i * nn;
       dm_vcopy(P->D + i * nn, P->Lqq + i * nn, nn);
       if (P->sep) {
-        dm_vcopy(P->Lvv + i * nn, P->sys->mass, nn);
+        if (P->sys->mass != NULL)
+          dm_vcopy(P->Lvv + i * nn, P->sys->mass, nn);
+        else
+          dm_csr_to_dense(&P->sys->pattern->vv, P->sys->pattern->mass, P->Lvv + i * nn);
         return DM_OK;
       }
       for (a = 0; a < n; a++)
@@ -272,14 +330,18 @@ static int assemble(dm_prk *P, int mode, double h, const double *q0, const doubl
         R[i * n + a] = Lv[i * n + a] - pp[a] - h * acc;
       }
   }
-  if (jac) {
+  if (jac && !P->sparse) {
     if (N > sn)
       memset(P->Jm, 0, N * N * sizeof(double));
     newton_matrix(P, h, N);
     P->lvv_norm = dm_norm_inf(P->Lvv, s * P->nn);
   }
-  if (mode == DM_PRK_CSTEP)
-    return dm_prk_constr_assemble(P, h, q0, jac, e);
+  if (mode == DM_PRK_CSTEP && (st = dm_prk_constr_assemble(P, h, q0, jac, e)) != DM_OK)
+    return st;
+  if (jac && P->sparse) {
+    dm_prk_sparse_matrix(P, h);
+    P->lvv_norm = dm_prk_sparse_lvv_norm(P);
+  }
   return DM_OK;
 }
 
@@ -307,16 +369,25 @@ int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
 {
   size_t n = P->n, i;
   char bq[160], bv[160];
-  for (i = 0; i < P->s; i++) {
-    memcpy(P->Jm, P->Lvv + i * P->nn, P->nn * sizeof(double));
-    if (dm_smalllu_factor(P->Jm, n, P->perm) != DM_OK)
+  /* which stage's d2L/dv2 is singular, when there are dense ones to look
+   * at (scratch: an error path may allocate) */
+  double *A = P->Lvv != NULL ? malloc(P->nn * sizeof *A) : NULL;
+  size_t *perm = A != NULL ? malloc(n * sizeof *perm) : NULL;
+  for (i = 0; perm != NULL && i < P->s; i++) {
+    memcpy(A, P->Lvv + i * P->nn, P->nn * sizeof(double));
+    if (dm_smalllu_factor(A, n, perm) != DM_OK) {
+      free(A);
+      free(perm);
       return dm_err_set(e, DM_ESINGULAR,
                         "d2L/dv2 is singular at stage %zu (q = %s, v = %s): the Lagrangian of "
                         "'%s' is not regular (its Hessian in the velocities must be invertible)",
                         i + 1, dm_num_format_vec(bq, sizeof bq, P->Q + i * n, n),
                         dm_num_format_vec(bv, sizeof bv, P->X + i * n, n),
                         P->sys->name ? P->sys->name : "system");
+    }
   }
+  free(A);
+  free(perm);
   return dm_err_set(e, DM_ESINGULAR, "singular Newton matrix of the %s (h = %g)%s", what, h,
                     P->m ? "; the constraint gradients may be linearly dependent"
                          : "; try a smaller step");
@@ -338,13 +409,18 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
                         h, it);
     if (jac) {
       njac++;
-      st = dm_smalllu_factor(P->Jm, N, P->perm);
+      st = P->sparse ? dm_prk_sparse_factor(P, NULL) : dm_smalllu_factor(P->Jm, N, P->perm);
       if (st == DM_ESINGULAR)
         return dm_prk_singular(P, "stage equations", h, e);
+      if (st == DM_ENOMEM)
+        return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
       if (st != DM_OK)
         return dm_err_set(e, DM_EDOM, "non-finite Newton matrix (h = %g)", h);
     }
-    dm_smalllu_solve(P->Jm, N, P->perm, P->R);
+    if (P->sparse)
+      dm_prk_sparse_solve(P, P->R);
+    else
+      dm_smalllu_solve(P->Jm, N, P->perm, P->R);
     {
       /* X -= R; max |R| and max |X| of the velocities on the way (a NaN
        * in either makes d NaN: the test below catches it) */
@@ -510,14 +586,23 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
     return st;
   if ((st = assemble(P, DM_PRK_STEP, h, q0, p0, 1, e)) != DM_OK)
     return st;
-  if (dm_smalllu_factor(P->Jm, sn, P->perm) != DM_OK)
+  if ((P->sparse ? dm_prk_sparse_factor(P, NULL) : dm_smalllu_factor(P->Jm, sn, P->perm))
+      != DM_OK)
     return dm_prk_singular(P, "stage equations", h, e);
   for (c = 0; c < N2; c++) {
-    double *dV = P->rhs + c * sn;
+    double *dV = P->rhs + (P->large ? 0 : c * sn);
     for (i = 0; i < s; i++)
       for (a = 0; a < n; a++) {
         double v;
-        if (c < n) {
+        if (c < n && P->large) {
+          double lvq, dd;
+          dm_prk_sparse_entries(P, i, a, c, &lvq, &dd);
+          v = lvq;
+          for (j = 0; j < s; j++) {
+            dm_prk_sparse_entries(P, j, a, c, &lvq, &dd);
+            v -= h * At[i * s + j] * dd;
+          }
+        } else if (c < n) {
           v = P->Lvq[i * nn + a * n + c];
           for (j = 0; j < s; j++)
             v -= h * At[i * s + j] * P->D[j * nn + a * n + c];
@@ -526,7 +611,10 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
         }
         dV[i * n + a] = -v;
       }
-    dm_smalllu_solve(P->Jm, sn, P->perm, dV);
+    if (P->sparse)
+      dm_prk_sparse_solve(P, dV);
+    else
+      dm_smalllu_solve(P->Jm, sn, P->perm, dV);
     /* dQ_j = e_c (q part) + h sum_k a_jk dV_k, stored in Q as scratch */
     for (j = 0; j < s; j++)
       for (a = 0; a < n; a++) {
@@ -540,8 +628,11 @@ int dm_prk_jacobian(dm_prk *P, double h, const double *q0, const double *p0,
       for (j = 0; j < s; j++) {
         double f = 0.0;
         dq1 += b[j] * dV[j * n + a];
-        for (x = 0; x < n; x++)
-          f += P->D[j * nn + a * n + x] * P->Q[j * n + x] + P->Bm[j * nn + a * n + x] * dV[j * n + x];
+        if (P->large)
+          dm_prk_sparse_rowdot(P, j, a, P->Q + j * n, dV + j * n, &f);
+        else
+          for (x = 0; x < n; x++)
+            f += P->D[j * nn + a * n + x] * P->Q[j * n + x] + P->Bm[j * nn + a * n + x] * dV[j * n + x];
         dp1 += b[j] * f;
       }
       DPhi[a * N2 + c] = (c == a ? 1.0 : 0.0) + h * dq1;
@@ -581,11 +672,18 @@ int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
 int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
 {
   dm_prk *P;
-  int st = dm_prk_alloc(I->sys, t, I->opt.tol, I->opt.maxiter, I->opt.explicit_sv, &P, e);
+  int linear = dm_linear_mode_parse(I->opt.linear);
+  if (linear < 0)
+    return dm_err_set(e, DM_EINVAL, "option 'linear' must be \"auto\", \"dense\" or "
+                      "\"sparse\", got \"%s\"", I->opt.linear);
+  int st = dm_prk_alloc(I->sys, t, I->opt.tol, I->opt.maxiter, I->opt.explicit_sv, linear,
+                        &P, e);
   if (st != DM_OK)
     return st;
   I->state = P;
   P->simplified = I->opt.simplified;
+  I->stats.linear = P->sparse ? DM_LINEAR_SPARSE : DM_LINEAR_DENSE;
+  I->stats.nnz = P->sparse ? dm_prk_sparse_nnz(P) : 0;
   I->order = t->order;
   I->stages = (int)t->s;
   I->flags = DM_INTEG_VARIATIONAL | DM_INTEG_FORCES | DM_INTEG_CONSTRAINTS;

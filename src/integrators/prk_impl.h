@@ -12,6 +12,9 @@ enum dm_prk_mode {
   DM_PRK_CSTEP      /* V, stage multipliers (nK m), initial multiplier mu0 (m) */
 };
 
+/* The sparse Newton matrix (prk_sparse.c). */
+typedef struct dm_prk_sparse dm_prk_sparse;
+
 /* Structure of a constant mass matrix (explicit Stormer-Verlet). */
 enum dm_prk_mass { DM_MASS_FULL, DM_MASS_DIAG, DM_MASS_UNIT };
 
@@ -32,7 +35,11 @@ struct dm_prk {
    * type tableau), plus mu0 on p0 and g(q1) = 0 (see prk_constrained.c) */
   size_t nK, K[DM_TABLEAU_SMAX];
   size_t Nmax;
-  double *Jm;                  /* Nmax x Nmax Newton matrix, then its LU */
+  double *block;               /* the one allocation the arrays below share */
+  int sparse;                  /* the Newton matrix is sparse (sp), not Jm */
+  int large;                   /* sparse, and no n x n stage arrays at all */
+  dm_prk_sparse *sp;
+  double *Jm;                  /* Nmax x Nmax Newton matrix, then its LU (dense) */
   size_t *perm;
   double *R;                   /* Nmax residual / update */
   double *X;                   /* Nmax unknowns; V = X[0 .. sn) */
@@ -49,7 +56,8 @@ struct dm_prk {
   double *E;                   /* s x s extrapolation matrix */
   double *cq, *cp;             /* Kahan carries */
   /* separable systems */
-  double *Minv;                /* n x n */
+  double *Mdiag;               /* n: the diagonal of M^{-1} */
+  double *Minv;                /* n x n, a full mass only (malloc'ed) */
   int mass_kind;               /* DM_MASS_UNIT / _DIAG / _FULL: how M^{-1} applies */
   double *svf;                 /* Lq at hq1 (first same as last) */
   int svf_valid;
@@ -64,6 +72,29 @@ int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e);
 /* DM_OK, or the error of a discrete Legendre transform that cannot be
  * taken (constrained system, h = 0). */
 int dm_prk_dleg_check(const dm_prk *P, double h, dm_err *e);
+
+/* prk_sparse.c */
+/* The sparse matrix for the engine (its stage values from the dense
+ * arrays, or, large, from values on the system's pattern). */
+int dm_prk_sparse_setup(dm_prk *P, int large, dm_err *e);
+void dm_prk_sparse_free(dm_prk_sparse *S);
+/* Stage i's second derivatives from the dense stage arrays (after
+ * dm_prk_eval_stage). */
+void dm_prk_sparse_gather(dm_prk *P, size_t i);
+/* dm_prk_eval_stage of the large engine. */
+int dm_prk_sparse_eval_stage(dm_prk *P, size_t i, int jac, int want_L, dm_err *e);
+double dm_prk_sparse_lvv_norm(const dm_prk *P);
+/* The matrix's values for step h (after every stage and, with
+ * constraints, dm_prk_constr_assemble). */
+void dm_prk_sparse_matrix(dm_prk *P, double h);
+int dm_prk_sparse_factor(dm_prk *P, dm_err *e);
+void dm_prk_sparse_solve(dm_prk *P, double *b);
+/* *f += row a of (D_j xq + Bm_j xv); entry (a, c) of Lvq_j and D_j. */
+void dm_prk_sparse_rowdot(const dm_prk *P, size_t j, size_t a, const double *xq,
+                          const double *xv, double *f);
+void dm_prk_sparse_entries(const dm_prk *P, size_t j, size_t a, size_t c, double *lvq,
+                           double *d);
+size_t dm_prk_sparse_nnz(const dm_prk *P);
 
 /* prk_constrained.c */
 int dm_prk_constr_layout(dm_prk *P, dm_err *e);

@@ -26,29 +26,54 @@ static int is_lobatto2(const dm_tableau *t)
          && t->at[2] == 0.5 && t->at[3] == 0.0 && t->b[0] == 0.5 && t->b[1] == 0.5;
 }
 
+/* The mass's structure (unit, diagonal, full: from the dense matrix, or
+ * from the pattern of a large system, whose mass is diagonal), its
+ * inverse's diagonal exactly (reciprocals), and for a full mass the
+ * inverse by Cholesky. */
 int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
 {
   const dm_system *sys = P->sys;
-  size_t n = P->n;
-  gsl_matrix_view Mi;
+  const dm_sys_pattern *pat = sys->pattern;
+  const double *M = sys->mass;
+  size_t n = P->n, i;
   P->explicit_sv = 0;
-  if (!is_lobatto2(P->tab) || !(sys->flags & DM_SYS_SEPARABLE) || sys->mass == NULL || P->forced)
+  if (!is_lobatto2(P->tab) || !(sys->flags & DM_SYS_SEPARABLE) || P->forced ||
+      (M == NULL && (pat == NULL || pat->mass == NULL || pat->vv.nnz != n)))
     return DM_OK;
-  memcpy(P->Minv, sys->mass, n * n * sizeof(double));
-  Mi = gsl_matrix_view_array(P->Minv, n, n);
-  if (gsl_linalg_cholesky_decomp1(&Mi.matrix) != 0 || gsl_linalg_cholesky_invert(&Mi.matrix) != 0)
+  P->mass_kind = DM_MASS_UNIT;
+  int spd = 1;
+  if (M != NULL) {
+    for (i = 0; i < n * n; i++)
+      if (i / n != i % n && M[i] != 0.0)
+        P->mass_kind = DM_MASS_FULL;
+      else if (i / n == i % n && M[i] != 1.0 && P->mass_kind == DM_MASS_UNIT)
+        P->mass_kind = DM_MASS_DIAG;
+    for (i = 0; i < n; i++) {
+      spd &= M[i * n + i] > 0.0 && isfinite(M[i * n + i]);
+      P->Mdiag[i] = 1.0 / M[i * n + i];
+    }
+  } else {                                  /* n diagonal entries on vv */
+    for (i = 0; i < n; i++) {
+      double mi = pat->mass[i];
+      spd &= pat->vv.col[pat->vv.rowptr[i]] == i && mi > 0.0 && isfinite(mi);
+      if (mi != 1.0)
+        P->mass_kind = DM_MASS_DIAG;
+      P->Mdiag[i] = 1.0 / mi;
+    }
+  }
+  if (P->mass_kind == DM_MASS_FULL) {
+    gsl_matrix_view Mi;
+    if ((P->Minv = malloc(n * n * sizeof *P->Minv)) == NULL)
+      return dm_err_set(e, DM_ENOMEM, "integrator: out of memory");
+    memcpy(P->Minv, M, n * n * sizeof(double));
+    Mi = gsl_matrix_view_array(P->Minv, n, n);
+    spd = gsl_linalg_cholesky_decomp1(&Mi.matrix) == 0 &&
+          gsl_linalg_cholesky_invert(&Mi.matrix) == 0;
+  }
+  if (!spd)
     return dm_err_set(e, DM_EINVAL, "system '%s' is flagged separable but its mass matrix is not "
                       "symmetric positive definite", sys->name ? sys->name : "?");
   P->explicit_sv = 1;
-  P->mass_kind = DM_MASS_UNIT;
-  for (size_t i = 0; i < n * n; i++)
-    if (i / n != i % n && sys->mass[i] != 0.0)
-      P->mass_kind = DM_MASS_FULL;
-    else if (i / n == i % n && sys->mass[i] != 1.0 && P->mass_kind == DM_MASS_UNIT)
-      P->mass_kind = DM_MASS_DIAG;
-  if (P->mass_kind == DM_MASS_DIAG)      /* exact reciprocals, not the Cholesky inverse */
-    for (size_t i = 0; i < n; i++)
-      P->Minv[i * n + i] = 1.0 / sys->mass[i * n + i];
   return DM_OK;
 }
 
@@ -71,7 +96,7 @@ static inline void minv_mul(const dm_prk *P, const double *x, double *y)
     break;
   case DM_MASS_DIAG:
     for (i = 0; i < n; i++)
-      y[i] = Mi[i * n + i] * x[i];
+      y[i] = P->Mdiag[i] * x[i];
     break;
   default:
     for (i = 0; i < n; i++) {
@@ -264,7 +289,7 @@ static void drift(const dm_prk *P, double h, const double *q, const double *p, c
     return;
   }
   for (i = 0; i < n; i++)
-    q1[i] = drift1(P->mass_kind, P->Minv[i * n + i], h, p[i] + hh * f[i], q[i], c[i], cn + i,
+    q1[i] = drift1(P->mass_kind, P->Mdiag[i], h, p[i] + hh * f[i], q[i], c[i], cn + i,
                    u + i);
 }
 
@@ -288,7 +313,7 @@ int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long 
   const dm_system *sys = P->sys;
   const size_t n = P->n;
   const int kind = P->mass_kind;
-  const double *Mi = P->Minv;
+  const double *Md = P->Mdiag;
   double *f0 = P->Lq, *f1 = P->Lq + n, *tmp;
   /* speculative positions of the next substep, and the position carries
    * and drift velocities of the state (c), of the next substep (s) and of
@@ -356,7 +381,7 @@ int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long 
         bad |= !isfinite(t) | !isfinite(qi);
         cp[i] = (t - pw[i]) - y;
         pn[i] = t;
-        qt[i] = drift1(kind, Mi[i * n + i], hk1, t + hh1 * f, qi, cqs[i], cqt + i, ut + i);
+        qt[i] = drift1(kind, Md[i], hk1, t + hh1 * f, qi, cqs[i], cqt + i, ut + i);
       }
     } else {
       for (i = 0; i < n; i++) {

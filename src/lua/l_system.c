@@ -366,17 +366,49 @@ static size_t trace_field(lua_State *L, int t, const char *field, const int *arg
   return cnt;
 }
 
+static int cmp_expr(const void *a, const void *b)
+{
+  dm_expr x = *(const dm_expr *)a, y = *(const dm_expr *)b;
+  return (x > y) - (x < y);
+}
+
+/* A coordinate is cyclic when neither L nor the force nor the constraints
+ * contain it: the symbols of all of them collected once (sorted), each
+ * coordinate looked up -- linear in the size of the expressions, not n
+ * times it. */
 static void detect_cyclic(lua_State *L, dm_lsystem *ls)
 {
   dm_expr_ctx *ctx = dm_lua_exprctx(L);
-  for (size_t i = 0; i < ls->n; i++) {
-    int dep = dm_expr_depends(ctx, ls->L, 1, &ls->q[i]);
-    for (size_t k = 0; !dep && ls->force && k < ls->n; k++)
-      dep = dm_expr_depends(ctx, ls->force[k], 1, &ls->q[i]);
-    for (size_t k = 0; !dep && k < ls->m; k++)
-      dep = dm_expr_depends(ctx, ls->constr[k], 1, &ls->q[i]);
-    ls->cyclic[i] = !dep;
+  size_t nroots = 1 + (ls->force ? ls->n : 0) + ls->m, k = 0, nv = 0;
+  dm_expr *roots = malloc(nroots * sizeof *roots);
+  if (roots == NULL)
+    luaL_error(L, "out of memory");
+  roots[k++] = ls->L;
+  for (size_t i = 0; ls->force && i < ls->n; i++)
+    roots[k++] = ls->force[i];
+  for (size_t i = 0; i < ls->m; i++)
+    roots[k++] = ls->constr[i];
+  dm_expr *vars = NULL;
+  int oom = 0;
+  for (size_t r = 0; r < nroots && !oom; r++) {
+    long c = dm_expr_free_vars(ctx, roots[r], NULL, 0);
+    dm_expr *nv2 = c > 0 ? realloc(vars, (nv + (size_t)c) * sizeof *vars) : vars;
+    oom = c > 0 && nv2 == NULL;
+    if (!oom)
+      vars = nv2;
+    if (!oom && c > 0)
+      nv += (size_t)dm_expr_free_vars(ctx, roots[r], vars + nv, (size_t)c);
   }
+  free(roots);
+  if (oom) {
+    free(vars);
+    luaL_error(L, "out of memory");
+  }
+  if (nv > 0)
+    qsort(vars, nv, sizeof *vars, cmp_expr);
+  for (size_t i = 0; i < ls->n; i++)
+    ls->cyclic[i] = nv == 0 || bsearch(&ls->q[i], vars, nv, sizeof *vars, cmp_expr) == NULL;
+  free(vars);
 }
 
 static int native_mode(lua_State *L, int t)
