@@ -358,27 +358,38 @@ int dm_conn_holonomy(dm_conn *C, size_t npieces, const dm_conn_curve_fn *curves,
   return DM_OK;
 }
 
+int dm_conn_transport_polygon(dm_conn *C, const double *xs, size_t n, const dm_conn_topts *o,
+                              double *H, dm_err *e)
+{
+  const dm_lie_group *G = C->B->G;
+  double P[DM_LIE_NQ_MAX];
+  size_t k;
+  int st;
+  if (n < 2)
+    return dm_err_set(e, DM_EINVAL, "transport: a polygon needs at least 2 points, got %zu", n);
+  dm_lie_identity(G, H);
+  for (k = 0; k + 1 < n; k++) {
+    if ((k & 1023) == 1023 && dm_interrupted())
+      return dm_err_set(e, DM_EINTR, "transport: interrupted at edge %zu of %zu", k + 1, n - 1);
+    if ((st = dm_conn_transport_segment(C, xs + k * C->nx, xs + (k + 1) * C->nx, o, P, e)) != DM_OK)
+      return st;
+    dm_lie_compose(G, H, P, H);
+  }
+  return DM_OK;
+}
+
 int dm_conn_holonomy_polygon(dm_conn *C, const double *xs, size_t n, const double *q0,
                              const dm_conn_topts *o, double *spatial, double *body, dm_err *e)
 {
-  const dm_lie_group *G = C->B->G;
-  double P[DM_LIE_NQ_MAX], H[DM_LIE_NQ_MAX];
-  size_t k;
+  double P[DM_LIE_NQ_MAX];
   int st;
   if (n < 2)
     return dm_err_set(e, DM_EINVAL, "holonomy: a loop needs at least 2 points, got %zu", n);
   if ((st = closed_check(C->nx, xs, xs + (n - 1) * C->nx, "holonomy", e)) != DM_OK ||
-      (st = closed_check(C->nx, q0, xs, "holonomy (q0 over the first point)", e)) != DM_OK)
+      (st = closed_check(C->nx, q0, xs, "holonomy (q0 over the first point)", e)) != DM_OK ||
+      (st = dm_conn_transport_polygon(C, xs, n, o, P, e)) != DM_OK)
     return st;
-  dm_lie_identity(G, P);
-  for (k = 0; k + 1 < n; k++) {
-    if ((k & 1023) == 1023 && dm_interrupted())
-      return dm_err_set(e, DM_EINTR, "holonomy: interrupted at edge %zu of %zu", k + 1, n - 1);
-    if ((st = dm_conn_transport_segment(C, xs + k * C->nx, xs + (k + 1) * C->nx, o, H, e)) != DM_OK)
-      return st;
-    dm_lie_compose(G, P, H, P);
-  }
-  holo_out(G, q0 + C->nx, P, spatial, body);
+  holo_out(C->B->G, q0 + C->nx, P, spatial, body);
   return DM_OK;
 }
 

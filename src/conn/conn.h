@@ -201,6 +201,15 @@ int dm_conn_curvature(dm_conn *C, const double *x, size_t i, size_t j, double *b
 /* A shape path s in [0, 1] -> x(s), x'(s). */
 typedef int (*dm_conn_curve_fn)(void *ud, double s, double *x, double *dx, dm_err *e);
 
+/* A shape path from expressions: x(s) (nx nodes of the caller's context in
+ * the symbol s), compiled with its exact derivative; evaluate it through
+ * dm_conn_curve_eval as a dm_conn_curve_fn with ud = the curve. */
+typedef struct dm_conn_curve dm_conn_curve;
+dm_conn_curve *dm_conn_curve_alloc(dm_expr_ctx *ctx, dm_expr s, size_t nx, const dm_expr *x,
+                                   dm_err *e);
+void dm_conn_curve_free(dm_conn_curve *c);
+int dm_conn_curve_eval(void *ud, double s, double *x, double *dx, dm_err *e);
+
 /* Transport options: Magnus 4 on `substeps` equal pieces (>= 1), or, when
  * tol > 0, adaptive Runge-Kutta-Prince-Dormand 8 (GSL rk8pd) with
  * absolute and relative tolerance tol. */
@@ -216,6 +225,9 @@ int dm_conn_transport(dm_conn *C, dm_conn_curve_fn curve, void *ud, const dm_con
 /* Along the straight segment x0 -> x1 of the chart. */
 int dm_conn_transport_segment(dm_conn *C, const double *x0, const double *x1,
                               const dm_conn_topts *o, double *H, dm_err *e);
+/* Along the polygon xs (n >= 2 points of nx) with straight edges. */
+int dm_conn_transport_polygon(dm_conn *C, const double *xs, size_t n, const dm_conn_topts *o,
+                              double *H, dm_err *e);
 /* Holonomy of a closed path (the end point must equal the start: DM_EINVAL
  * otherwise, tolerance 1e-9 relative) from q0 = (x0, g0): spatial, body
  * (either may be NULL).  npieces paths are followed one after the other
@@ -288,6 +300,14 @@ dm_conn_dc *dm_conn_dc_mechanical(const dm_conn_bundle *B, dm_expr_ctx *ctx,
                                   const dm_expr *q0, const dm_expr *q1, dm_expr Ld,
                                   size_t npar, const dm_expr *par, const double *parval,
                                   dm_conn_dc *guess, double tol, int maxit, dm_err *e);
+/* The midpoint discrete Lagrangian of a reduced Lagrangian l(x, xdot, xi)
+ * on a trivial bundle: Ld = h l((x0 + x1)/2, (x1 - x0)/h, log(g0^-1 g1)/h)
+ * as nodes in the symbols q0 = (x0, g0), q1 = (x1, g1) (nq each);
+ * G-invariant for any group.  xs, xd (nx) and xi (dim) are the symbols l
+ * is written in. */
+int dm_conn_midpoint_ld(dm_expr_ctx *ctx, const dm_conn_bundle *B, const dm_expr *q0,
+                        const dm_expr *q1, const dm_expr *xs, const dm_expr *xd,
+                        const dm_expr *xi, dm_expr l, double h, dm_expr *Ld, dm_err *e);
 /* The discrete momentum J_d(q0, q1) (dim) of a mechanical connection. */
 int dm_conn_dc_momentum(dm_conn_dc *D, const double *q0, const double *q1, double *J, dm_err *e);
 /* Target momentum mu (dim; NULL: zero).  DM_EUNSUP for non-abelian G

@@ -22,6 +22,7 @@
 #include "conn/conn_impl.h"
 #include "core/newton.h"
 #include "core/smalllu.h"
+#include "core/numfmt.h"
 
 struct conn_mech {
   dm_tape *t;                   /* in: k (G->nq); par: q0, q1, user; out: J, Jac */
@@ -210,16 +211,6 @@ int dm_conn_dc_momentum(dm_conn_dc *D, const double *q0, const double *q1, doubl
   return DM_OK;
 }
 
-static void fmt_point(char *buf, size_t size, const double *x, size_t n)
-{
-  size_t i, len = 0;
-  buf[0] = '\0';
-  for (i = 0; i < n && len + 32 < size; i++)
-    len += (size_t)snprintf(buf + len, size - len, "%s%.6g", i ? ", " : "(", x[i]);
-  if (len + 2 < size)
-    snprintf(buf + len, size - len, "%s)", i < n ? ", ..." : "");
-}
-
 int dm_conn__mech_solve(dm_conn_dc *D, const double *q0, const double *q1, double *k, dm_err *e)
 {
   conn_mech *m = D->mech;
@@ -252,8 +243,8 @@ int dm_conn__mech_solve(dm_conn_dc *D, const double *q0, const double *q1, doubl
       break;
     st = dm_smalllu_factor(m->jac, dim, m->perm);
     if (st != DM_OK) {
-      fmt_point(p0, sizeof p0, q0, m->nq);
-      fmt_point(p1, sizeof p1, q1, m->nq);
+      dm_num_format_vec(p0, sizeof p0, q0, m->nq);
+      dm_num_format_vec(p1, sizeof p1, q1, m->nq);
       return dm_err_set(e, DM_ESINGULAR, "discrete mechanical connection: singular momentum "
                         "Jacobian (the discrete Lagrangian is not group-regular there) at "
                         "q0 = %s, q1 = %s", p0, p1);
@@ -265,9 +256,49 @@ int dm_conn__mech_solve(dm_conn_dc *D, const double *q0, const double *q1, doubl
     if (dm_newton_done(&t, dm_conn__norm(eta, dim), m->tol))
       return DM_OK;
   }
-  fmt_point(p0, sizeof p0, q0, m->nq);
-  fmt_point(p1, sizeof p1, q1, m->nq);
+  dm_num_format_vec(p0, sizeof p0, q0, m->nq);
+  dm_num_format_vec(p1, sizeof p1, q1, m->nq);
   return dm_err_set(e, DM_ENOCONV, "discrete mechanical connection: Newton did not converge in "
                     "%d iterations (residual %.3g, tolerance %.3g) at q0 = %s, q1 = %s",
                     m->maxit, res, m->tol, p0, p1);
+}
+
+int dm_conn_midpoint_ld(dm_expr_ctx *ctx, const dm_conn_bundle *B, const dm_expr *q0,
+                        const dm_expr *q1, const dm_expr *xs, const dm_expr *xd,
+                        const dm_expr *xi, dm_expr l, double h, dm_expr *Ld, dm_err *e)
+{
+  const dm_lie_group *G;
+  size_t nx, dim, i;
+  dm_expr from[2 * DM_CONN_NX_MAX + DM_LIE_DIM_MAX], to[2 * DM_CONN_NX_MAX + DM_LIE_DIM_MAX],
+          gi[DM_LIE_NQ_MAX], F[DM_LIE_NQ_MAX], w[DM_LIE_DIM_MAX], hh, half;
+  int st;
+  if (B == NULL || !dm_conn_bundle_is_trivial(B))
+    return dm_err_set(e, DM_EUNSUP, "midpoint discrete Lagrangian: needs a trivial bundle S x G");
+  if (!(h > 0.0))
+    return dm_err_set(e, DM_EINVAL, "midpoint discrete Lagrangian: h must be > 0, got %g", h);
+  G = B->G;
+  nx = B->nx;
+  dim = G->dim;
+  if ((st = dm_lie_sym_inverse(ctx, G, q0 + nx, gi, e)) != DM_OK ||
+      (st = dm_lie_sym_compose(ctx, G, gi, q1 + nx, F, e)) != DM_OK ||
+      (st = dm_lie_sym_log(ctx, G, F, w, e)) != DM_OK)
+    return st;
+  hh = dm_expr_const(ctx, h);
+  half = dm_expr_const(ctx, 0.5);
+  for (i = 0; i < nx; i++) {
+    from[i] = xs[i];
+    to[i] = dm_expr_mul(ctx, half, dm_expr_add(ctx, q0[i], q1[i]));
+    from[nx + i] = xd[i];
+    to[nx + i] = dm_expr_div(ctx, dm_expr_sub(ctx, q1[i], q0[i]), hh);
+  }
+  for (i = 0; i < dim; i++) {
+    from[2 * nx + i] = xi[i];
+    to[2 * nx + i] = dm_expr_div(ctx, w[i], hh);
+  }
+  if ((st = dm_expr_subs(ctx, 1, &l, Ld, 2 * nx + dim, from, to, e)) != DM_OK)
+    return st;
+  *Ld = dm_expr_mul(ctx, hh, *Ld);
+  if (*Ld == DM_EXPR_NONE)
+    return dm_err_set(e, DM_ENOMEM, "midpoint discrete Lagrangian: %s", dm_expr_ctx_err(ctx)->msg);
+  return DM_OK;
 }

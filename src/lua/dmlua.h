@@ -167,6 +167,7 @@ int dm_lua_integrator(lua_State *L);
  * userdata owns it: keep the userdata on the stack while using it. */
 struct dm_integrator *dm_lua_tointegrator(lua_State *L, int idx);
 void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
+void dm_open_conn(lua_State *L);        /* dm.bundle, dm.connection, ... (l_conn*.c) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

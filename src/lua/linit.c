@@ -18,6 +18,7 @@ static const dm_opener openers[] = {
   dm_open_reduce,
   dm_open_dec,
   dm_open_lie,
+  dm_open_conn,
   NULL
 };
 

@@ -1,0 +1,974 @@
+/* l_conn.c -- bundles and their points in Lua (src/conn/conn.h):
+ *   B = dm.bundle{shape_dim = 2, group = dm.lie.SO2()}        -- S x G
+ *   B = dm.bundle{system = sys, acts_on = {"theta"}}          -- from a dm.system
+ *   B = dm.bundle{name = "platform", I = 1, m = 1}            -- the catalog (dm.bundles)
+ *   S = dm.sphere_frames() ; P = dm.bundle{name = "particles", n = 4}
+ *   q = B:point{x = {0.5, 0}, g = 0} ; q.x ; q.g ; B:act(g, q) ...
+ * and the shared readers of l_conn.h.  See l_conn.h. */
+#include <config.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lua/l_conn.h"
+#include "lua/l_expr.h"
+#include "lua/l_system.h"
+
+/* {==== helpers ============================================================= */
+
+void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known)
+{
+  idx = lua_absindex(L, idx);
+  lua_pushnil(L);
+  while (lua_next(L, idx) != 0) {
+    int ok = 0;
+    size_t k;
+    lua_pop(L, 1);
+    if (lua_type(L, -1) == LUA_TSTRING)
+      for (k = 0; known[k] != NULL && !ok; k++)
+        ok = strcmp(lua_tostring(L, -1), known[k]) == 0;
+    if (!ok) {
+      luaL_Buffer b;
+      luaL_buffinit(L, &b);
+      for (k = 0; known[k] != NULL; k++) {
+        if (k)
+          luaL_addstring(&b, ", ");
+        luaL_addstring(&b, known[k]);
+      }
+      luaL_pushresult(&b);
+      luaL_error(L, "%s: unknown option '%s' (options: %s)", fname,
+                 lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : luaL_typename(L, -2),
+                 lua_tostring(L, -1));
+    }
+  }
+}
+
+void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o)
+{
+  lua_Integer n;
+  o->substeps = 8;
+  o->tol = 0.0;
+  if (idx == 0 || lua_isnoneornil(L, idx))
+    return;
+  if (!lua_istable(L, idx))
+    luaL_error(L, "%s: options must be a table {substeps = n, tol = t}, got %s", fname,
+               luaL_typename(L, idx));
+  n = dm_optintegerfield(L, idx, "substeps", 8);
+  if (n < 1 || n > 1000000)
+    luaL_error(L, "%s: substeps must be 1..1000000, got %d", fname, (int)n);
+  o->substeps = (size_t)n;
+  o->tol = dm_optnumberfield(L, idx, "tol", 0.0);
+  if (!(o->tol >= 0.0) || (o->tol > 0.0 && o->tol < 1e-15))
+    luaL_error(L, "%s: tol must be 0 (Magnus 4) or in [1e-15, ...) (adaptive), got %f", fname,
+               o->tol);
+}
+
+static size_t readnums(lua_State *L, int idx, const char *what, double *x, size_t n)
+{
+  gsl_vector *v = dm_tovec(L, idx);
+  size_t k;
+  if (v != NULL) {
+    if (v->size != n)
+      luaL_error(L, "%s must have %d entries, got %d", what, (int)n, (int)v->size);
+    for (k = 0; k < n; k++)
+      x[k] = gsl_vector_get(v, k);
+    return n;
+  }
+  if (n == 1 && lua_type(L, idx) == LUA_TNUMBER) {
+    x[0] = lua_tonumber(L, idx);
+    return 1;
+  }
+  if (!lua_istable(L, idx))
+    luaL_error(L, "%s must be a vec or a list of %d numbers, got %s", what, (int)n,
+               luaL_typename(L, idx));
+  if ((size_t)luaL_len(L, idx) != n)
+    luaL_error(L, "%s must have %d entries, got %d", what, (int)n, (int)luaL_len(L, idx));
+  for (k = 0; k < n; k++) {
+    lua_geti(L, idx, (lua_Integer)k + 1);
+    if (lua_type(L, -1) != LUA_TNUMBER)
+      luaL_error(L, "%s[%d] must be a number, got %s", what, (int)k + 1, luaL_typename(L, -1));
+    x[k] = lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  return n;
+}
+
+void dm_lua_readshape(lua_State *L, const dm_conn_bundle *B, int idx, const char *what, double *x)
+{
+  dm_err e;
+  idx = lua_absindex(L, idx);
+  if (B->nx == 0 && lua_isnoneornil(L, idx))
+    return;
+  readnums(L, idx, what, x, B->nx);
+  if (dm_conn_shape_check(B, x, what, &e) != DM_OK)
+    luaL_error(L, "%s", e.msg);
+}
+
+double *dm_lua_readshapes(lua_State *L, const dm_conn_bundle *B, int idx, const char *what,
+                          size_t *n)
+{
+  gsl_matrix *M = dm_tomat(L, idx);
+  gsl_vector *buf;
+  char w[160];
+  size_t k, i;
+  dm_err e;
+  idx = lua_absindex(L, idx);
+  if (M != NULL) {
+    if (M->size2 != B->nx)
+      luaL_error(L, "%s: a matrix with %d columns (one point per row) expected, got %d", what,
+                 (int)B->nx, (int)M->size2);
+    *n = M->size1;
+    buf = dm_pushvec(L, *n * B->nx + 1);
+    for (k = 0; k < *n; k++)
+      for (i = 0; i < B->nx; i++)
+        buf->data[k * B->nx + i] = gsl_matrix_get(M, k, i);
+  } else {
+    if (!lua_istable(L, idx))
+      luaL_error(L, "%s: a list of shape points expected, got %s", what, luaL_typename(L, idx));
+    *n = (size_t)luaL_len(L, idx);
+    buf = dm_pushvec(L, *n * B->nx + 1);
+    for (k = 0; k < *n; k++) {
+      snprintf(w, sizeof w, "%s[%d]", what, (int)k + 1);
+      lua_geti(L, idx, (lua_Integer)k + 1);
+      readnums(L, -1, w, buf->data + k * B->nx, B->nx);
+      lua_pop(L, 1);
+    }
+  }
+  for (k = 0; k < *n; k++) {
+    snprintf(w, sizeof w, "%s[%d]", what, (int)k + 1);
+    if (dm_conn_shape_check(B, buf->data + k * B->nx, w, &e) != DM_OK)
+      luaL_error(L, "%s", e.msg);
+  }
+  return buf->data;
+}
+
+void dm_lua_readgroupelem(lua_State *L, int gidx, int idx, const char *what, double *g)
+{
+  const dm_lie_group *G = dm_lua_checkgroup(L, gidx);
+  dm_lelem *el = dm_lua_toelem(L, idx);
+  if (el != NULL) {
+    if (!dm_lie_group_equal(el->G, G))
+      luaL_error(L, "%s must be an element of %s, got an element of %s", what, G->name,
+                 el->G->name);
+    dm_lua_elem_numbers(L, el, what, g);
+    return;
+  }
+  if (lua_type(L, idx) != LUA_TNUMBER && !lua_istable(L, idx) && dm_tovec(L, idx) == NULL)
+    luaL_error(L, "%s must be an element of %s (or its %d coordinates), got %s", what, G->name,
+               (int)G->nq, luaL_typename(L, idx));
+  readnums(L, idx, what, g, G->nq);
+}
+
+void dm_lua_pushgroupelem(lua_State *L, int gidx, const double *g)
+{
+  dm_lelem *el = dm_lua_newelem(L, gidx, 0);
+  size_t i;
+  for (i = 0; i < el->G->nq; i++)
+    el->v[i].x = g[i];
+}
+
+static int holo_tostring(lua_State *L)
+{
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  luaL_addstring(&b, "holonomy");
+  if (lua_getfield(L, 1, "angle") == LUA_TNUMBER) {
+    char num[32];
+    dm_num_snprintf(num, sizeof num, "%.10g", lua_tonumber(L, -1));
+    luaL_addstring(&b, ": angle ");
+    luaL_addstring(&b, num);
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "axis") != LUA_TNIL) {
+    luaL_addstring(&b, " about ");
+    luaL_addstring(&b, luaL_tolstring(L, -1, NULL));
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  if (lua_getfield(L, 1, "body") != LUA_TNIL) {
+    luaL_addstring(&b, "; body ");
+    luaL_addstring(&b, luaL_tolstring(L, -1, NULL));
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  luaL_pushresult(&b);
+  return 1;
+}
+
+void dm_lua_pushholonomy(lua_State *L, int gidx, const double *spatial, const double *body,
+                         double lifted)
+{
+  const dm_lie_group *G = dm_lua_checkgroup(L, gidx);
+  double w[DM_LIE_DIM_MAX], ang = NAN;
+  gidx = lua_absindex(L, gidx);
+  lua_createtable(L, 0, 4);
+  dm_lua_pushgroupelem(L, gidx, spatial);
+  lua_setfield(L, -2, "spatial");
+  if (body != NULL) {
+    dm_lua_pushgroupelem(L, gidx, body);
+    lua_setfield(L, -2, "body");
+  }
+  if (G->kind == DM_LIE_SO2 || G->kind == DM_LIE_SE2 || (G->kind == DM_LIE_RN && G->dim == 1)) {
+    ang = isfinite(lifted) ? lifted : (body ? body[0] : spatial[0]);
+  } else if (G->kind == DM_LIE_SO3) {
+    double n;
+    dm_lie_log(G, body ? body : spatial, w);
+    n = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    ang = n;
+    if (n > 0) {
+      w[0] /= n;
+      w[1] /= n;
+      w[2] /= n;
+      dm_pushvec_copy(L, w, 3);
+      lua_setfield(L, -2, "axis");
+    }
+  }
+  if (isfinite(ang)) {
+    lua_pushnumber(L, ang);
+    lua_setfield(L, -2, "angle");
+  }
+  if (luaL_newmetatable(L, "dmech.holonomy")) {
+    lua_pushcfunction(L, holo_tostring);
+    lua_setfield(L, -2, "__tostring");
+  }
+  lua_setmetatable(L, -2);
+}
+
+/* }==== */
+
+/* {==== bundles ============================================================= */
+
+static dm_lbundle *tobundle(lua_State *L, int idx)
+{
+  return luaL_testudata(L, idx, DM_BUNDLE_MT);
+}
+
+dm_lbundle *dm_lua_checkbundle(lua_State *L, int idx)
+{
+  dm_lbundle *b = tobundle(L, idx);
+  if (b == NULL || b->B == NULL)
+    dm_argexpected(L, idx, "bundle (dm.bundle{...})", luaL_typename(L, idx));
+  return b;
+}
+
+void dm_lua_bundle_field(lua_State *L, int bidx, const char *key)
+{
+  lua_getiuservalue(L, bidx, 1);
+  lua_getfield(L, -1, key);
+  lua_remove(L, -2);
+}
+
+static int bundle_gc(lua_State *L)
+{
+  dm_lbundle *b = luaL_checkudata(L, 1, DM_BUNDLE_MT);
+  dm_conn_bundle_free(b->B);
+  b->B = NULL;
+  return 0;
+}
+
+/* an empty bundle userdata with its user value table {group = G} (the
+ * group userdata at gidx) */
+static dm_lbundle *newbundle(lua_State *L, int gidx)
+{
+  dm_lbundle *b;
+  gidx = lua_absindex(L, gidx);
+  b = lua_newuserdatauv(L, sizeof *b, 1);
+  b->B = NULL;
+  luaL_setmetatable(L, DM_BUNDLE_MT);
+  lua_newtable(L);
+  lua_pushvalue(L, gidx);
+  lua_setfield(L, -2, "group");
+  lua_setiuservalue(L, -2, 1);
+  return b;
+}
+
+static void set_uv(lua_State *L, int bidx, const char *key, int vidx)
+{
+  bidx = lua_absindex(L, bidx);
+  vidx = lua_absindex(L, vidx);
+  lua_getiuservalue(L, bidx, 1);
+  lua_pushvalue(L, vidx);
+  lua_setfield(L, -2, key);
+  lua_pop(L, 1);
+}
+
+/* params: {name = value, ...} (sorted by name) or {{"name", value}, ...}
+ * into a list {{name, value}, ...} pushed on the stack */
+static void read_params(lua_State *L, int idx, const char *fname)
+{
+  int n = 0, k;
+  lua_newtable(L);
+  if (lua_isnoneornil(L, idx))
+    return;
+  if (!lua_istable(L, idx))
+    luaL_error(L, "%s: params must be a table of numbers by name, got %s", fname,
+               luaL_typename(L, idx));
+  if (luaL_len(L, idx) > 0) {
+    for (k = 1; k <= luaL_len(L, idx); k++) {
+      lua_geti(L, idx, k);
+      if (!lua_istable(L, -1))
+        luaL_error(L, "%s: params[%d] must be {\"name\", value}", fname, k);
+      lua_geti(L, -1, 1);
+      lua_geti(L, -2, 2);
+      if (lua_type(L, -2) != LUA_TSTRING || lua_type(L, -1) != LUA_TNUMBER)
+        luaL_error(L, "%s: params[%d] must be {\"name\", value}", fname, k);
+      lua_pop(L, 2);
+      lua_rawseti(L, -2, ++n);
+    }
+    return;
+  }
+  /* dictionary: collect the names, sort them */
+  lua_newtable(L);
+  lua_pushnil(L);
+  while (lua_next(L, idx) != 0) {
+    if (lua_type(L, -2) != LUA_TSTRING || lua_type(L, -1) != LUA_TNUMBER)
+      luaL_error(L, "%s: params must map names to numbers (key %s)", fname,
+                 luaL_typename(L, -2));
+    lua_pop(L, 1);
+    lua_pushvalue(L, -1);
+    lua_rawseti(L, -3, ++n);
+  }
+  lua_getglobal(L, "table");
+  lua_getfield(L, -1, "sort");
+  lua_pushvalue(L, -3);
+  lua_call(L, 1, 0);
+  lua_pop(L, 1);
+  for (k = 1; k <= n; k++) {
+    lua_createtable(L, 2, 0);
+    lua_geti(L, -2, k);
+    lua_pushvalue(L, -1);
+    lua_rawseti(L, -3, 1);
+    lua_gettable(L, idx);
+    lua_rawseti(L, -2, 2);
+    lua_rawseti(L, -3, k);
+  }
+  lua_pop(L, 1);
+}
+
+static const char *const bundle_keys[] = {"shape_dim", "group", "L", "A", "params", "name",
+                                          "system", "acts_on", "n", NULL};
+
+/* a trivial bundle over the shape coordinates of a traced system, the
+ * group acting by translation on the coordinates acts_on */
+static int bundle_from_system(lua_State *L, int o)
+{
+  dm_lsystem *ls;
+  size_t r, k, i, nshape = 0;
+  int gidx;
+  dm_lbundle *b;
+  dm_err e;
+  lua_getfield(L, o, "system");
+  ls = dm_lua_checktraced(L, -1, "dm.bundle");
+  lua_getfield(L, o, "acts_on");
+  if (!lua_istable(L, -1) || luaL_len(L, -1) < 1)
+    luaL_error(L, "dm.bundle: acts_on must list the coordinates the group moves ({\"theta\"})");
+  r = (size_t)luaL_len(L, -1);
+  lua_newtable(L);                      /* index list: acts (1-based) */
+  for (k = 1; k <= r; k++) {
+    long j = -1;
+    lua_geti(L, -2, (lua_Integer)k);
+    if (lua_type(L, -1) != LUA_TSTRING ||
+        (j = dm_lua_system_coord(ls, lua_tostring(L, -1))) < 0)
+      luaL_error(L, "dm.bundle: acts_on[%d] is not a coordinate of system '%s'", (int)k,
+                 ls->sys.name);
+    if (!ls->cyclic[j])
+      luaL_error(L, "dm.bundle: the Lagrangian of '%s' depends on %s: the group does not act "
+                 "by symmetries", ls->sys.name, lua_tostring(L, -1));
+    lua_pop(L, 1);
+    lua_pushinteger(L, j + 1);
+    lua_rawseti(L, -2, (lua_Integer)k);
+  }
+  lua_getfield(L, o, "group");
+  if (lua_isnil(L, -1)) {
+    dm_lie_group **slot;
+    lua_pop(L, 1);
+    slot = dm_lua_newgroup(L);
+    *slot = r == 1 ? dm_lie_so2(&e) : dm_lie_torus(r, &e);
+    if (*slot == NULL)
+      return dm_lua_fail(L, "dm.bundle", e.status, &e);
+  }
+  gidx = lua_gettop(L);
+  if (dm_lua_checkgroup(L, gidx)->dim != r || !dm_lua_checkgroup(L, gidx)->abelian ||
+      dm_lua_checkgroup(L, gidx)->nq != r)
+    luaL_error(L, "dm.bundle: the group acting on %d coordinates by translation must be "
+               "abelian of dimension %d (R^n, SO(2), T^n), got %s", (int)r, (int)r,
+               dm_lua_checkgroup(L, gidx)->name);
+  nshape = ls->n - r;
+  b = newbundle(L, gidx);
+  if ((b->B = dm_conn_bundle_trivial(nshape, dm_lua_checkgroup(L, gidx), &e)) == NULL)
+    return dm_lua_fail(L, "dm.bundle", e.status, &e);
+  snprintf(b->B->name, sizeof b->B->name, "%s / %s", ls->sys.name, dm_lua_checkgroup(L, gidx)->name);
+  set_uv(L, -1, "system", o + 1);
+  set_uv(L, -1, "acts", gidx - 1);
+  (void)i;
+  return 1;
+}
+
+static int l_bundle(lua_State *L)
+{
+  lua_Integer m;
+  dm_lbundle *b;
+  dm_err e;
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_settop(L, 1);
+  lua_getfield(L, 1, "name");
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    const char *name = lua_tostring(L, -1);
+    if (strcmp(name, "sphere_frames") == 0 || strcmp(name, "sphere frames") == 0) {
+      dm_lie_group **slot = dm_lua_newgroup(L);
+      if ((*slot = dm_lie_so2(&e)) == NULL)
+        return dm_lua_fail(L, "dm.bundle", e.status, &e);
+      b = newbundle(L, -1);
+      if ((b->B = dm_conn_bundle_sphere_frames(&e)) == NULL)
+        return dm_lua_fail(L, "dm.bundle", e.status, &e);
+      return 1;
+    }
+    if (strcmp(name, "particles") == 0) {
+      lua_Integer n = dm_optintegerfield(L, 1, "n", 0);
+      dm_lie_group **slot = dm_lua_newgroup(L);
+      if ((*slot = dm_lie_so3(&e)) == NULL)
+        return dm_lua_fail(L, "dm.bundle", e.status, &e);
+      b = newbundle(L, -1);
+      if (n < 2 || n > DM_CONN_NX_MAX / 3)
+        luaL_error(L, "dm.bundle: particles needs n = 2..%d, got %d", DM_CONN_NX_MAX / 3, (int)n);
+      if ((b->B = dm_conn_bundle_particles((size_t)n, &e)) == NULL)
+        return dm_lua_fail(L, "dm.bundle", e.status, &e);
+      return 1;
+    }
+    if (lua_isnil(L, (lua_getfield(L, 1, "shape_dim"), -1))) {
+      /* the catalog: dm.bundles[name](opts) */
+      lua_getglobal(L, "require");
+      lua_pushliteral(L, "dmech.core");
+      lua_call(L, 1, 1);
+      lua_getfield(L, -1, "bundles");
+      if (!lua_istable(L, -1) || (lua_getfield(L, -1, name), !lua_isfunction(L, -1)))
+        luaL_error(L, "dm.bundle: no built-in bundle '%s' (see dm.bundles: platform, cat, "
+                   "heisenberg, rotor, orbiter; and sphere_frames, particles)", name);
+      lua_pushvalue(L, 1);
+      lua_call(L, 1, 1);
+      return 1;
+    }
+    lua_pop(L, 1);
+  }
+  dm_lua_conn_checkkeys(L, 1, "dm.bundle", bundle_keys);
+  lua_getfield(L, 1, "system");
+  if (!lua_isnil(L, -1)) {
+    lua_pop(L, 2);
+    return bundle_from_system(L, 1);
+  }
+  lua_settop(L, 1);
+  lua_getfield(L, 1, "group");                  /* 2 */
+  if (dm_lua_togroup(L, 2) == NULL)
+    luaL_error(L, "dm.bundle: group must be a Lie group (dm.lie.SO2(), ...), got %s",
+               luaL_typename(L, 2));
+  m = dm_optintegerfield(L, 1, "shape_dim", -1);
+  if (m < 0 || m > DM_CONN_NX_MAX)
+    luaL_error(L, "dm.bundle: shape_dim must be 0..%d, got %d", DM_CONN_NX_MAX, (int)m);
+  lua_getfield(L, 1, "L");                      /* 3 */
+  if (!lua_isnil(L, 3) && !lua_isfunction(L, 3))
+    luaL_error(L, "dm.bundle: L must be a function l(x, xdot, xi, p), got %s", luaL_typename(L, 3));
+  lua_getfield(L, 1, "params");
+  read_params(L, 4, "dm.bundle");               /* 5 */
+  b = newbundle(L, 2);                          /* 6 */
+  if ((b->B = dm_conn_bundle_trivial((size_t)m, dm_lua_checkgroup(L, 2), &e)) == NULL)
+    return dm_lua_fail(L, "dm.bundle", e.status, &e);
+  set_uv(L, 6, "L", 3);
+  set_uv(L, 6, "params", 5);
+  lua_getfield(L, 1, "A");
+  if (!lua_isnil(L, -1) && !lua_isfunction(L, -1))
+    luaL_error(L, "dm.bundle: A must be a function A(x, p) (the bundle's connection form), got %s",
+               luaL_typename(L, -1));
+  set_uv(L, 6, "A", -1);
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "name");
+  if (lua_type(L, -1) == LUA_TSTRING)
+    snprintf(b->B->name, sizeof b->B->name, "%s", lua_tostring(L, -1));
+  lua_pop(L, 1);
+  return 1;
+}
+
+static int l_sphere_frames(lua_State *L)
+{
+  lua_settop(L, 0);
+  lua_createtable(L, 0, 1);
+  lua_pushliteral(L, "sphere_frames");
+  lua_setfield(L, 1, "name");
+  return l_bundle(L);
+}
+
+int dm_lua_bundle_lagrangian(lua_State *L, int bidx, dm_expr *xs, dm_expr *xd, dm_expr *xi,
+                             dm_expr *par, double *parval, size_t *npar, dm_expr *l)
+{
+  dm_lbundle *b = dm_lua_checkbundle(L, bidx);
+  const dm_conn_bundle *B = b->B;
+  size_t k;
+  int top = lua_gettop(L);
+  bidx = lua_absindex(L, bidx);
+  dm_lua_bundle_field(L, bidx, "system");
+  if (!lua_isnil(L, -1)) {
+    dm_lsystem *ls = dm_lua_tosystem(L, -1);
+    unsigned char acts[256] = {0};
+    size_t ns = 0, na = 0;
+    dm_lua_bundle_field(L, bidx, "acts");
+    for (k = 1; k <= (size_t)luaL_len(L, -1); k++) {
+      lua_geti(L, -1, (lua_Integer)k);
+      acts[lua_tointeger(L, -1) - 1] = 1;
+      xi[na++] = ls->v[lua_tointeger(L, -1) - 1];
+      lua_pop(L, 1);
+    }
+    for (k = 0; k < ls->n; k++)
+      if (!acts[k]) {
+        xs[ns] = ls->q[k];
+        xd[ns++] = ls->v[k];
+      }
+    if (ls->npar > 32)
+      luaL_error(L, "mechanical connection: at most 32 parameters");
+    for (k = 0; k < ls->npar; k++) {
+      par[k] = ls->par[k];
+      parval[k] = ls->sys.par[k];
+    }
+    *npar = ls->npar;
+    *l = ls->L;
+    lua_settop(L, top);
+    return 1;
+  }
+  lua_pop(L, 1);
+  dm_lua_bundle_field(L, bidx, "L");
+  if (lua_isnil(L, -1)) {
+    lua_settop(L, top);
+    return 0;
+  }
+  dm_lua_bundle_field(L, bidx, "params");
+  dm_lua_trace_lagrangian(L, B, top + 1, top + 2, xs, xd, xi, par, parval, npar, l);
+  lua_settop(L, top);
+  return 1;
+}
+
+void dm_lua_trace_lagrangian(lua_State *L, const dm_conn_bundle *B, int fidx, int pidx,
+                             dm_expr *xs, dm_expr *xd, dm_expr *xi, dm_expr *par, double *parval,
+                             size_t *npar, dm_expr *l)
+{
+  const char *xn[DM_CONN_NX_MAX], *dn[DM_CONN_NX_MAX], *gn[DM_LIE_DIM_MAX], *pn[32];
+  char names[3][DM_CONN_NX_MAX > DM_LIE_DIM_MAX ? DM_CONN_NX_MAX : DM_LIE_DIM_MAX][16];
+  size_t k, nx = B->nx, dim = B->G->dim, np;
+  int top = lua_gettop(L);
+  fidx = lua_absindex(L, fidx);
+  pidx = lua_absindex(L, pidx);
+  for (k = 0; k < nx; k++) {
+    snprintf(names[0][k], 16, "x%d", (int)k + 1);
+    snprintf(names[1][k], 16, "xdot%d", (int)k + 1);
+    xn[k] = names[0][k];
+    dn[k] = names[1][k];
+  }
+  for (k = 0; k < dim; k++) {
+    snprintf(names[2][k], 16, "xi%d", (int)k + 1);
+    gn[k] = names[2][k];
+  }
+  np = lua_istable(L, pidx) ? (size_t)luaL_len(L, pidx) : 0;
+  if (np > 32)
+    luaL_error(L, "Lagrangian: at most 32 parameters");
+  /* the names stay referenced by the list at pidx while we trace */
+  for (k = 0; k < np; k++) {
+    lua_geti(L, pidx, (lua_Integer)k + 1);
+    lua_geti(L, -1, 1);
+    lua_geti(L, -2, 2);
+    if (lua_type(L, -2) != LUA_TSTRING || lua_type(L, -1) != LUA_TNUMBER)
+      luaL_error(L, "Lagrangian: params[%d] must be {\"name\", value}", (int)k + 1);
+    pn[k] = lua_tostring(L, -2);
+    parval[k] = lua_tonumber(L, -1);
+    lua_pop(L, 3);
+  }
+  lua_pushvalue(L, fidx);
+  dm_lua_pushsymvec(L, "x", nx, xn, NULL, DM_EXPR_SYM);
+  dm_lua_pushsymvec(L, "xdot", nx, dn, NULL, DM_EXPR_SYM);
+  dm_lua_pushsymvec(L, "xi", dim, gn, NULL, DM_EXPR_SYM);
+  dm_lua_pushsymvec(L, "p", np, pn, NULL, DM_EXPR_PARAM);
+  for (k = 0; k < np; k++) {
+    lua_geti(L, -1, (lua_Integer)k + 1);
+    par[k] = dm_lua_toexpr(L, -1);
+    lua_pop(L, 1);
+  }
+  for (k = 0; k < nx; k++) {
+    lua_geti(L, -4, (lua_Integer)k + 1);
+    xs[k] = dm_lua_toexpr(L, -1);
+    lua_geti(L, -4, (lua_Integer)k + 1);
+    xd[k] = dm_lua_toexpr(L, -1);
+    lua_pop(L, 2);
+  }
+  for (k = 0; k < dim; k++) {
+    lua_geti(L, -2, (lua_Integer)k + 1);
+    xi[k] = dm_lua_toexpr(L, -1);
+    lua_pop(L, 1);
+  }
+  dm_lua_trace(L, "the Lagrangian l(x, xdot, xi, p)", 4);
+  if ((*l = dm_lua_toexpr(L, -1)) == DM_EXPR_NONE)
+    luaL_error(L, "the Lagrangian l(x, xdot, xi, p) must return an expression or a number, "
+               "got %s", luaL_typename(L, -1));
+  *npar = np;
+  lua_settop(L, top);
+}
+
+/* }==== */
+
+/* {==== points ============================================================== */
+
+static dm_lbpoint *topoint(lua_State *L, int idx)
+{
+  return luaL_testudata(L, idx, DM_BPOINT_MT);
+}
+
+dm_lbpoint *dm_lua_pushpoint(lua_State *L, int bidx, const double *q)
+{
+  dm_lbundle *b = dm_lua_checkbundle(L, bidx);
+  dm_lbpoint *p;
+  bidx = lua_absindex(L, bidx);
+  p = lua_newuserdatauv(L, sizeof *p + b->B->nq * sizeof(double), 1);
+  p->B = b->B;
+  memcpy(p->q, q, b->B->nq * sizeof *q);
+  luaL_setmetatable(L, DM_BPOINT_MT);
+  lua_pushvalue(L, bidx);
+  lua_setiuservalue(L, -2, 1);
+  return p;
+}
+
+/* B:point{...} contents at idx into q */
+static void point_from_table(lua_State *L, int bidx, int idx, const char *what, double *q)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, bidx)->B;
+  char w[160];
+  dm_err e;
+  idx = lua_absindex(L, idx);
+  if (dm_conn_bundle_is_trivial(B)) {
+    lua_getfield(L, idx, "x");
+    lua_getfield(L, idx, "g");
+    if ((B->nx > 0 && lua_isnil(L, -2)) || lua_isnil(L, -1))
+      luaL_error(L, "%s: a point {x = {...}, g = ...} of %s expected", what, B->name);
+    snprintf(w, sizeof w, "%s.x", what);
+    dm_lua_readshape(L, B, -2, w, q);
+    snprintf(w, sizeof w, "%s.g", what);
+    dm_lua_bundle_field(L, bidx, "group");
+    dm_lua_readgroupelem(L, -1, -2, w, q + B->nx);
+    lua_pop(L, 3);
+    return;
+  }
+  if (strcmp(B->type->name, "sphere_frames") == 0) {
+    dm_lelem *el;
+    double R[9];
+    lua_getfield(L, idx, "R");
+    el = dm_lua_toelem(L, -1);
+    if (el != NULL && el->G->kind == DM_LIE_SO3) {
+      dm_lua_elem_numbers(L, el, what, R);
+    } else if (dm_tomat(L, -1) != NULL) {
+      gsl_matrix *M = dm_tomat(L, -1);
+      size_t i;
+      if (M->size1 != 3 || M->size2 != 3)
+        luaL_error(L, "%s.R: a 3x3 matrix expected", what);
+      for (i = 0; i < 9; i++)
+        R[i] = gsl_matrix_get(M, i / 3, i % 3);
+    } else {
+      luaL_error(L, "%s: a frame {R = <SO3 element>} expected, got R = %s", what,
+                 luaL_typename(L, -1));
+    }
+    {
+      dm_lie_group *G3 = dm_lie_so3(NULL);
+      int st = G3 ? dm_lie_check(G3, R, 1e-10, &e) : DM_ENOMEM;
+      dm_lie_group_free(G3);
+      if (st != DM_OK)
+        luaL_error(L, "%s.R: %s", what, e.msg);
+    }
+    memcpy(q, R, sizeof R);
+    lua_pop(L, 1);
+    return;
+  }
+  lua_getfield(L, idx, "q");
+  if (lua_isnil(L, -1))
+    luaL_error(L, "%s: a point {q = {...}} (%d coordinates) expected", what, (int)B->nq);
+  snprintf(w, sizeof w, "%s.q", what);
+  readnums(L, -1, w, q, B->nq);
+  if (dm_conn_shape_check(B, q, w, &e) != DM_OK)
+    luaL_error(L, "%s", e.msg);
+  lua_pop(L, 1);
+}
+
+void dm_lua_readpoint(lua_State *L, int bidx, int idx, const char *what, double *q)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, bidx)->B;
+  dm_lbpoint *p = topoint(L, idx);
+  if (p != NULL) {
+    if (p->B != B && (p->B->nq != B->nq || p->B->type != B->type ||
+                      !dm_lie_group_equal(p->B->G, B->G)))
+      luaL_error(L, "%s: a point of %s expected, got a point of %s", what, B->name, p->B->name);
+    memcpy(q, p->q, B->nq * sizeof *q);
+    return;
+  }
+  if (lua_istable(L, idx) && luaL_len(L, idx) == 0) {
+    point_from_table(L, bidx, idx, what, q);
+    return;
+  }
+  if (lua_istable(L, idx) || dm_tovec(L, idx) != NULL) {
+    readnums(L, idx, what, q, B->nq);
+    return;
+  }
+  luaL_error(L, "%s: a point of %s (B:point{...}) expected, got %s", what, B->name,
+             luaL_typename(L, idx));
+}
+
+static int b_point(lua_State *L)
+{
+  dm_lbundle *b = dm_lua_checkbundle(L, 1);
+  double q[DM_CONN_NQ_MAX];
+  luaL_checktype(L, 2, LUA_TTABLE);
+  point_from_table(L, 1, 2, "point", q);
+  dm_lua_pushpoint(L, 1, q);
+  (void)b;
+  return 1;
+}
+
+static int b_proj(lua_State *L)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
+  double q[DM_CONN_NQ_MAX], x[DM_CONN_NX_MAX];
+  dm_lua_readpoint(L, 1, 2, "proj: q", q);
+  dm_conn_proj(B, q, x);
+  dm_pushvec_copy(L, x, B->nx);
+  return 1;
+}
+
+static int b_act(lua_State *L)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
+  double q[DM_CONN_NQ_MAX], g[DM_LIE_NQ_MAX], gq[DM_CONN_NQ_MAX];
+  dm_lua_bundle_field(L, 1, "group");
+  dm_lua_readgroupelem(L, -1, 2, "act: g", g);
+  dm_lua_readpoint(L, 1, 3, "act: q", q);
+  dm_conn_act(B, g, q, gq);
+  dm_lua_pushpoint(L, 1, gq);
+  return 1;
+}
+
+static int b_fiber_diff(lua_State *L)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
+  double q[DM_CONN_NQ_MAX], q2[DM_CONN_NQ_MAX], g[DM_LIE_NQ_MAX], gap;
+  dm_err e;
+  dm_lua_readpoint(L, 1, 2, "fiber_diff: q", q);
+  dm_lua_readpoint(L, 1, 3, "fiber_diff: q2", q2);
+  gap = dm_conn_shape_gap(B, q, q2);
+  if (!(gap <= 1e-9))
+    luaL_error(L, "fiber_diff: q and q2 are not on one fibre (their shapes differ by %f)", gap);
+  if (dm_conn_fiber_diff(B, q, q2, g, &e) != DM_OK)
+    return dm_lua_fail(L, "fiber_diff", e.status, &e);
+  dm_lua_bundle_field(L, 1, "group");
+  dm_lua_pushgroupelem(L, -1, g);
+  return 1;
+}
+
+static int b_section(lua_State *L)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
+  double q[DM_CONN_NQ_MAX], x[DM_CONN_NX_MAX];
+  dm_err e;
+  dm_lua_readshape(L, B, 2, "section: x", x);
+  if (dm_conn_section(B, x, q, &e) != DM_OK)
+    return dm_lua_fail(L, "section", e.status, &e);
+  dm_lua_pushpoint(L, 1, q);
+  return 1;
+}
+
+static int b_trivialize(lua_State *L)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
+  double q[DM_CONN_NQ_MAX], x[DM_CONN_NX_MAX], g[DM_LIE_NQ_MAX];
+  dm_err e;
+  dm_lua_readpoint(L, 1, 2, "trivialize: q", q);
+  if (dm_conn_trivialize(B, q, x, g, &e) != DM_OK)
+    return dm_lua_fail(L, "trivialize", e.status, &e);
+  dm_pushvec_copy(L, x, B->nx);
+  dm_lua_bundle_field(L, 1, "group");
+  dm_lua_pushgroupelem(L, -1, g);
+  lua_remove(L, -2);
+  return 2;
+}
+
+static int b_tostring(lua_State *L)
+{
+  dm_lbundle *b = luaL_checkudata(L, 1, DM_BUNDLE_MT);
+  if (b->B == NULL) {
+    lua_pushliteral(L, "<Bundle (freed)>");
+    return 1;
+  }
+  lua_pushfstring(L, "<Bundle %s (%s): shape dim %d, group %s>", b->B->name, b->B->type->name,
+                  (int)b->B->dimS, b->B->G->name);
+  return 1;
+}
+
+static const dm_reg bundle_methods[] = {
+  {"point", b_point, "B:point{x = {...}, g = ...} | {R = R} | {q = {...}} -> point",
+   "A point of the bundle: shape coordinates and group element (S x G), a frame R (sphere frames), or coordinates (particles)."},
+  {"proj", b_proj, "B:proj(q) -> vec", "The shape point of q (chart coordinates)."},
+  {"act", b_act, "B:act(g, q) -> point", "The left action g . q of the structure group."},
+  {"fiber_diff", b_fiber_diff, "B:fiber_diff(q, q2) -> g",
+   "The group element g with q2 = g . q (q and q2 on one fibre)."},
+  {"section", b_section, "B:section(x) -> point",
+   "The point of the bundle's section over the shape point x (error when the bundle has none)."},
+  {"trivialize", b_trivialize, "B:trivialize(q) -> x, g",
+   "The shape point and group element with q = g . section(x)."},
+  {NULL, NULL, NULL, NULL}
+};
+
+static int bundle_index(lua_State *L)
+{
+  dm_lbundle *b = luaL_checkudata(L, 1, DM_BUNDLE_MT);
+  const char *k = lua_tostring(L, 2);
+  if (k != NULL && b->B != NULL) {
+    if (strcmp(k, "group") == 0) {
+      dm_lua_bundle_field(L, 1, "group");
+      return 1;
+    }
+    if (strcmp(k, "shape_dim") == 0) {
+      lua_pushinteger(L, (lua_Integer)b->B->dimS);
+      return 1;
+    }
+    if (strcmp(k, "name") == 0) {
+      lua_pushstring(L, b->B->name);
+      return 1;
+    }
+    if (strcmp(k, "kind") == 0) {
+      lua_pushstring(L, b->B->type->name);
+      return 1;
+    }
+    if (strcmp(k, "L") == 0 || strcmp(k, "params") == 0 || strcmp(k, "system") == 0) {
+      dm_lua_bundle_field(L, 1, k);
+      return 1;
+    }
+  }
+  lua_getmetatable(L, 1);
+  lua_getfield(L, -1, "__methods");
+  lua_pushvalue(L, 2);
+  lua_rawget(L, -2);
+  return 1;
+}
+
+/* }==== */
+
+/* {==== point class ========================================================= */
+
+static int p_coords(lua_State *L)
+{
+  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
+  dm_pushvec_copy(L, p->q, p->B->nq);
+  return 1;
+}
+
+static int p_bundle(lua_State *L)
+{
+  luaL_checkudata(L, 1, DM_BPOINT_MT);
+  lua_getiuservalue(L, 1, 1);
+  return 1;
+}
+
+static int point_index(lua_State *L)
+{
+  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
+  const char *k = lua_tostring(L, 2);
+  const dm_conn_bundle *B = p->B;
+  if (k != NULL) {
+    int triv = dm_conn_bundle_is_trivial(B), sph = strcmp(B->type->name, "sphere_frames") == 0;
+    if (strcmp(k, "x") == 0 || (sph && strcmp(k, "p") == 0)) {
+      double x[DM_CONN_NX_MAX];
+      dm_conn_proj(B, p->q, x);
+      dm_pushvec_copy(L, x, B->nx);
+      return 1;
+    }
+    if (strcmp(k, "g") == 0 && triv) {
+      lua_getiuservalue(L, 1, 1);
+      dm_lua_bundle_field(L, -1, "group");
+      dm_lua_pushgroupelem(L, -1, p->q + B->nx);
+      return 1;
+    }
+    if (strcmp(k, "R") == 0 && sph) {
+      dm_lie_group **slot = dm_lua_newgroup(L);
+      dm_err e;
+      if ((*slot = dm_lie_so3(&e)) == NULL)
+        return dm_lua_fail(L, "point.R", e.status, &e);
+      dm_lua_pushgroupelem(L, -1, p->q);
+      return 1;
+    }
+    if (strcmp(k, "q") == 0)
+      return p_coords(L);
+  }
+  lua_getmetatable(L, 1);
+  lua_getfield(L, -1, "__methods");
+  lua_pushvalue(L, 2);
+  lua_rawget(L, -2);
+  return 1;
+}
+
+static int point_tostring(lua_State *L)
+{
+  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
+  const dm_conn_bundle *B = p->B;
+  char buf[640], v[200], g[160];
+  if (dm_conn_bundle_is_trivial(B)) {
+    dm_num_format_vec(v, sizeof v, p->q, B->nx);
+    dm_lie_describe(B->G, p->q + B->nx, g, sizeof g);
+    snprintf(buf, sizeof buf, "<point of %s: x = %s, g = %s>", B->name, v, g);
+  } else if (strcmp(B->type->name, "sphere_frames") == 0) {
+    double x[3];
+    dm_conn_proj(B, p->q, x);
+    dm_num_format_vec(v, sizeof v, x, 3);
+    dm_num_format_vec(g, sizeof g, p->q, 9);
+    snprintf(buf, sizeof buf, "<frame over p = %s: R = %s>", v, g);
+  } else {
+    dm_num_format_vec(v, sizeof v, p->q, B->nq);
+    snprintf(buf, sizeof buf, "<point of %s: q = %s>", B->name, v);
+  }
+  lua_pushstring(L, buf);
+  return 1;
+}
+
+static const dm_reg point_methods[] = {
+  {"coords", p_coords, "q:coords() -> vec", "The stored coordinates of the point (shape chart, then group)."},
+  {"bundle", p_bundle, "q:bundle() -> B", "The bundle of the point."},
+  {NULL, NULL, NULL, NULL}
+};
+
+/* }==== */
+
+static const dm_reg conn_funcs[] = {
+  {"bundle", l_bundle,
+   "dm.bundle{shape_dim = m, group = G[, L = l, params = {...}]} | {name = \"platform\", ...} | {system = sys, acts_on = {...}} -> B",
+   "A principal bundle: the trivial S x G, a built-in one by name (dm.bundles, sphere_frames, particles), or the shape space of a dm.system whose group moves the coordinates acts_on."},
+  {"sphere_frames", l_sphere_frames, "dm.sphere_frames() -> B",
+   "The frame bundle SO(3) -> S^2 (p = R e3) with SO(2) turning the frame about p."},
+  {NULL, NULL, NULL, NULL}
+};
+
+void dm_open_conn(lua_State *L)
+{
+  int dm = lua_gettop(L);
+  static const luaL_Reg bmeta[] = {{"__index", bundle_index}, {"__gc", bundle_gc},
+                                   {"__close", bundle_gc}, {"__tostring", b_tostring},
+                                   {NULL, NULL}};
+  static const luaL_Reg pmeta[] = {{"__index", point_index}, {"__tostring", point_tostring},
+                                   {NULL, NULL}};
+  dm_newclass(L, DM_BUNDLE_MT, "B", bundle_methods, bmeta);
+  lua_pop(L, 1);
+  dm_newclass(L, DM_BPOINT_MT, "q", point_methods, pmeta);
+  lua_pop(L, 1);
+  lua_pushvalue(L, dm);
+  dm_register(L, "dm.", conn_funcs);
+  lua_pop(L, 1);
+  lua_settop(L, dm);
+  dm_lua_open_conn_cont(L);
+  dm_lua_open_conn_disc(L);
+  dm_lua_open_conn_mesh(L);
+  lua_settop(L, dm);
+  /* the catalog lua/dmech/bundles.lua: an installer called with dm */
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech.bundles");
+  lua_call(L, 1, 1);
+  lua_pushvalue(L, dm);
+  lua_call(L, 1, 0);
+  lua_settop(L, dm);
+}

@@ -1,0 +1,89 @@
+/* l_conn.h -- private glue of the connection bindings: l_conn.c (dm.bundle,
+ * bundles and their points), l_conn_cont.c (dm.connection,
+ * dm.mechanical_connection), l_conn_disc.c (dm.discrete_connection,
+ * dm.discrete_mechanical_connection, dm.order_test), l_conn_mesh.c (the
+ * Levi-Civita connection of a triangle mesh).
+ *
+ * A bundle is a userdata "dmech.bundle" owning a dm_conn_bundle; user value
+ * 1 is a table {group = <dm.lie group userdata>, L = <reduced Lagrangian
+ * l(x, xdot, xi, p) or nil>, params = {{name, value}, ...} or nil,
+ * system = <System or nil>, name = <catalog name or nil>}.  A point is a
+ * userdata "dmech.bpoint" holding nq numbers; user value 1 is its bundle.
+ * Connections keep their bundle (and parent, guess, Lua callbacks) in
+ * their user values, so C pointers into them stay valid.
+ */
+#ifndef DM_L_CONN_H
+#define DM_L_CONN_H
+
+#include "lua/dmlua.h"
+#include "lua/l_lie.h"
+#include "conn/conn.h"
+
+#define DM_BUNDLE_MT "dmech.bundle"
+#define DM_BPOINT_MT "dmech.bpoint"
+#define DM_CONN_MT "dmech.connection"
+#define DM_DCONN_MT "dmech.dconnection"
+#define DM_MESHCONN_MT "dmech.meshconnection"
+
+typedef struct dm_lbundle {
+  dm_conn_bundle *B;            /* NULL until built */
+} dm_lbundle;
+
+typedef struct dm_lbpoint {
+  const dm_conn_bundle *B;      /* owned by the bundle (user value 1) */
+  double q[];
+} dm_lbpoint;
+
+/* bundles and points (l_conn.c) */
+dm_lbundle *dm_lua_checkbundle(lua_State *L, int idx);
+/* Push the field `key` of the bundle's user value table. */
+void dm_lua_bundle_field(lua_State *L, int bidx, const char *key);
+/* A new point of the bundle at bidx holding q (nq numbers). */
+dm_lbpoint *dm_lua_pushpoint(lua_State *L, int bidx, const double *q);
+/* Read a point of the bundle at bidx from idx: a point of that bundle, or
+ * a table as B:point{...} takes, or nq coordinates.  Raises naming what. */
+void dm_lua_readpoint(lua_State *L, int bidx, int idx, const char *what, double *q);
+/* A shape point (nx numbers: a vec or a list), checked by the bundle. */
+void dm_lua_readshape(lua_State *L, const dm_conn_bundle *B, int idx, const char *what,
+                      double *x);
+/* A list of shape points (a list of vecs / lists, or a mat with one point
+ * per row) into a scratch vec pushed on the stack; returns the data and
+ * the count in *n. */
+double *dm_lua_readshapes(lua_State *L, const dm_conn_bundle *B, int idx, const char *what,
+                          size_t *n);
+/* A group element of G (the group userdata at gidx) from idx: an element,
+ * a number (one-coordinate groups) or the coordinates. */
+void dm_lua_readgroupelem(lua_State *L, int gidx, int idx, const char *what, double *g);
+/* Push a numeric element of the group userdata at gidx. */
+void dm_lua_pushgroupelem(lua_State *L, int gidx, const double *g);
+/* Push a holonomy result table {spatial, body, angle[, axis]} with a
+ * __tostring; gidx the group userdata; body may be NULL. */
+void dm_lua_pushholonomy(lua_State *L, int gidx, const double *spatial, const double *body,
+                         double lifted);
+/* The reduced Lagrangian of the bundle at bidx traced into nodes: pushes
+ * nothing, fills xs, xd (nx), xi (dim), par (npar) and *l; 0 when the
+ * bundle has no Lagrangian.  npar <= 32. */
+int dm_lua_bundle_lagrangian(lua_State *L, int bidx, dm_expr *xs, dm_expr *xd, dm_expr *xi,
+                             dm_expr *par, double *parval, size_t *npar, dm_expr *l);
+/* Trace l(x, xdot, xi, p) (the function at fidx, parameters {{name,
+ * value}, ...} at pidx) for the bundle B: fills the nodes as above. */
+void dm_lua_trace_lagrangian(lua_State *L, const dm_conn_bundle *B, int fidx, int pidx,
+                             dm_expr *xs, dm_expr *xd, dm_expr *xi, dm_expr *par, double *parval,
+                             size_t *npar, dm_expr *l);
+/* Options of a transport: {substeps = n, tol = t} at idx (0: none). */
+void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o);
+/* Raise "<fname>: unknown option 'k' (options: a, b)" for keys not in known. */
+void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known);
+
+/* continuous connections (l_conn_cont.c) */
+dm_conn *dm_lua_checkconn(lua_State *L, int idx);
+dm_conn *dm_lua_toconn(lua_State *L, int idx);
+void dm_lua_open_conn_cont(lua_State *L);
+/* discrete (l_conn_disc.c) and mesh (l_conn_mesh.c) connections */
+dm_conn_dc *dm_lua_todconn(lua_State *L, int idx);
+void dm_lua_open_conn_disc(lua_State *L);
+void dm_lua_open_conn_mesh(lua_State *L);
+/* the mesh connection constructor (dm.discrete_connection{mesh = M}) */
+int dm_lua_meshconn_new(lua_State *L, int midx);
+
+#endif
