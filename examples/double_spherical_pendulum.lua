@@ -78,7 +78,7 @@ print("  connection A =", red.A)
 local st, mu = red:project{q = q0, v = v0}
 red:set_mu(mu)
 do
-  local ev = red:eval(st.q)
+  local ev = red:eval{q = st.q}
   print(("  mu = J(q0, v0) = %.15g; at x0: I = %.15g, beta = %.6g dr1^dphi + %.6g dr2^dphi "
          .. "(the formula: print(red.beta), %d characters)"):format(mu, ev.I, ev.B[1][3], ev.B[2][3],
          #tostring(red.beta)))

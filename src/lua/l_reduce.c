@@ -404,7 +404,7 @@ static int r_index(lua_State *L)
     return luaL_error(L, "red.%s: '%s' is not mechanical (L is not quadratic in the velocities), "
                       "so it has no locked inertia, connection or amended potential; its "
                       "reduction is the classical Routhian Rc = L - mu.thetadot on J = mu, "
-                      "evaluated numerically (red:eval(x, xdot) gives Rc and thetadot)", k,
+                      "evaluated numerically (red:eval{q = x, v = xdot} gives Rc and thetadot)", k,
                       dm_routh_full(red)->name);
   if (strcmp(k, "A") == 0)
     push_connection(L, red);

@@ -5,7 +5,7 @@
  *   local D = red:discrete{method = "gauss", stages = 2, h = 0.05}
  *   D:psi(x0, x1)               -> psi_mu, D1psi, D2psi
  *   D:lhat(x0, x1)              -> Lhat, {D1 =, D2 =, A1 =, A2 =}
- *   D:legendre(x0, x1)          -> s0, s1      (reduced discrete Legendre transforms)
+ *   D:dlegendre(x0, x1)         -> s0, s1      (reduced discrete Legendre transforms)
  *   D:residual(xp, xc, xn)      -> DR residual, shape part of DEL
  *   D:solve(xp, xc)             -> xn          (DR equations solved for x_{k+1})
  *   D:dtheta(x0, x1, dth0, dx0, dx1) -> dth1   (reconstruction of tangent vectors)
@@ -139,10 +139,10 @@ static int d_legendre(lua_State *L)
   double *A1 = D2 + s, *A2 = A1 + s;
   dm_err e;
   int st;
-  read_x(L, 1, 2, "legendre: x0", x0);
-  read_x(L, 1, 3, "legendre: x1", x1);
+  read_x(L, 1, 2, "dlegendre: x0", x0);
+  read_x(L, 1, 3, "dlegendre: x1", x1);
   if ((st = dm_routh_dr_lhat(D->dr, D->h, x0, x1, NULL, D1, D2, A1, A2, &e)) != DM_OK)
-    return dm_lua_fail(L, "legendre", st, &e);
+    return dm_lua_fail(L, "dlegendre", st, &e);
   for (i = 0; i < s; i++) {      /* F- = -D1 Lhat + Ahat_1, F+ = D2 Lhat - Ahat_2 */
     D1[i] = A1[i] - D1[i];
     D2[i] -= A2[i];
@@ -227,7 +227,7 @@ static int ldr_index(lua_State *L)
     lua_getiuservalue(L, 1, 1);
   else
     return luaL_error(L, "discrete Routh object has no field or method '%s' (fields: h, method, "
-                      "stages, reduction; methods: psi, lhat, legendre, residual, solve, dtheta)", k);
+                      "stages, reduction; methods: psi, lhat, dlegendre, residual, solve, dtheta)", k);
   return 1;
 }
 
@@ -320,7 +320,7 @@ static const dm_reg dr_methods[] = {
   {"lhat", d_lhat, "D:lhat(x0, x1) -> Lhat, {D1 =, D2 =, A1 =, A2 =}",
    "The reduced discrete Lagrangian Lhat(x0, x1) = L_d((0, x0), (psi_mu, x1)), its derivatives "
    "D1 Lhat, D2 Lhat and the one-forms Ahat_1, Ahat_2 of the discrete Routh equations."},
-  {"legendre", d_legendre, "D:legendre(x0, x1) -> s0, s1",
+  {"dlegendre", d_legendre, "D:dlegendre(x0, x1) -> s0, s1",
    "The reduced discrete Legendre transforms s0 = -D1 Lhat + Ahat_1 and s1 = D2 Lhat - Ahat_2 "
    "(the reduced momenta p_x - mu^T A at both ends)."},
   {"residual", d_residual, "D:residual(x_prev, x_cur, x_next) -> dr, del",

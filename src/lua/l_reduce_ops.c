@@ -151,6 +151,39 @@ static void read_reduced_state(lua_State *L, dm_lrouth *u, int self, int idx, do
   lua_pop(L, 1);
 }
 
+/* A shape point with an optional velocity: {q = x[, v = xdot | p = s]}
+ * at idx into x, xd (zeros without v or p; from p by the reduced Legendre
+ * map); xd needs room for 2 s (scratch behind it). */
+static void read_shape_state(lua_State *L, dm_lrouth *u, int self, int idx, double *x, double *xd,
+                             const char *fname)
+{
+  dm_lsystem *rs = sys_of(L, self, 1);
+  size_t s = rs->n;
+  char what[64];
+  dm_err e;
+  int st;
+  if (lua_type(L, idx) != LUA_TTABLE || lua_rawlen(L, idx) > 0)
+    luaL_error(L, "%s: a reduced state {q = x[, v = xdot | p = s]} expected, got %s", fname,
+               lua_type(L, idx) == LUA_TTABLE ? "a list" : luaL_typename(L, idx));
+  if (lua_getfield(L, idx, "q") == LUA_TNIL)
+    luaL_error(L, "%s: the state needs q (the shape coordinates)", fname);
+  snprintf(what, sizeof what, "%s: state.q", fname);
+  dm_lua_system_readvec(L, rs, -1, what, x);
+  lua_pop(L, 1);
+  memset(xd, 0, s * sizeof *xd);
+  if (lua_getfield(L, idx, "v") != LUA_TNIL) {
+    snprintf(what, sizeof what, "%s: state.v", fname);
+    dm_lua_system_readvec(L, rs, -1, what, xd);
+  } else if (lua_getfield(L, idx, "p") != LUA_TNIL) {
+    snprintf(what, sizeof what, "%s: state.p", fname);
+    dm_lua_system_readvec(L, rs, -1, what, xd + s);
+    if ((st = dm_routh_velocity(u->red, x, xd + s, xd, &e)) != DM_OK)
+      dm_lua_fail(L, fname, st, &e);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+}
+
 static void push_state(lua_State *L, int with_t, double t, const double *q, const double *p,
                        const double *v, size_t n)
 {
@@ -324,17 +357,14 @@ static int m_eval(lua_State *L)
 {
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
-  dm_lsystem *rs = sys_of(L, 1, 1);
   size_t r = x->r, s = x->s;
-  double *buf = scratch_top(L, 3, 2 * s + 2 * r * r + 2 * r * s + 2 * r + s + 2 * s * s);
+  double *buf = scratch_top(L, 2, 3 * s + 2 * r * r + 2 * r * s + 2 * r + s + 2 * s * s);
   double *xx = buf, *xd = xx + s, *I = xd + s, *Ii = I + r * r, *A = Ii + r * r, *w = A + r * s;
   double *muA = w + r, *Mt = muA + s, *B = Mt + s * s, *thd = B + s * s;
   dm_routh_vals v;
   dm_err e;
   int st;
-  dm_lua_system_readvec(L, rs, 2, "x", xx);
-  if (!lua_isnoneornil(L, 3))
-    dm_lua_system_readvec(L, rs, 3, "xdot", xd);
+  read_shape_state(L, u, 1, 2, xx, xd, "eval");
   if (!dm_routh_is_mechanical(u->red)) {
     memset(&v, 0, sizeof v);
     v.thetadot = thd;
@@ -430,8 +460,8 @@ const dm_reg dm_lrouth_methods[] = {
   {"phase", m_phase, "red:phase(loop) -> dynamic, geometric, gap",
    "Split the group advance over a (closed) shape loop into the dynamic part sum dt I^-1 mu and the "
    "geometric part -sum A(xbar) dx (midpoint rule); gap is the loop's closure defect."},
-  {"eval", m_eval, "red:eval(x[, xdot]) -> {I=, Iinv=, A=, B=, Mtilde=, amended=, routhian=, ...}",
-   "Numerical values of the derived objects at a shape point with the current mu."},
+  {"eval", m_eval, "red:eval{q = x[, v = xdot | p = s]} -> {I=, Iinv=, A=, B=, Mtilde=, amended=, routhian=, ...}",
+   "Numerical values of the derived objects at a reduced state (xdot = 0 without v or p) with the current mu."},
   {"discrete", dm_lrouth_discrete,
    "red:discrete{method = \"midpoint\" | \"gauss\" | \"lobatto\", stages =, h =} -> discrete",
    "The discrete Routh equations of the midpoint or Galerkin discrete Lagrangian of the full "

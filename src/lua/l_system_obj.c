@@ -35,49 +35,65 @@ static dm_lsystem *checksys(lua_State *L)
   return dm_lua_checksystem(L, 1);
 }
 
-/* Read (q, v) from arguments 2, 3 into ls->buf[0..2n). */
-static void read_qx(lua_State *L, dm_lsystem *ls, const char *fname, const char *xname)
+/* The state table {q=, v=} | {q=, p=} at argument 2 (v wins when both are
+ * given): q into ls->buf, v into buf + n (from p by the Legendre solve),
+ * and p into buf + 2n when the state gives it (returns 1, else 0). */
+static int read_state(lua_State *L, dm_lsystem *ls, const char *fname)
 {
   char what[64];
-  snprintf(what, sizeof what, "%s: q", fname);
-  dm_lua_system_readvec(L, ls, 2, what, ls->buf);
-  snprintf(what, sizeof what, "%s: %s", fname, xname);
-  dm_lua_system_readvec(L, ls, 3, what, ls->buf + ls->n);
+  double *q = ls->buf, *v = q + ls->n, *p = v + ls->n;
+  int has_v, has_p;
+  dm_err e;
+  int st;
+  if (lua_type(L, 2) != LUA_TTABLE || lua_rawlen(L, 2) > 0)
+    luaL_error(L, "%s: a state {q=, v=} or {q=, p=} expected, got %s (sys:%s(q, v) is written "
+               "sys:%s{q = q, v = v})", fname, lua_type(L, 2) == LUA_TTABLE ? "a list"
+               : luaL_typename(L, 2), fname, fname);
+  lua_settop(L, 3);
+  if (lua_getfield(L, 2, "q") == LUA_TNIL)
+    luaL_error(L, "%s: the state needs q", fname);
+  snprintf(what, sizeof what, "%s: state.q", fname);
+  dm_lua_system_readvec(L, ls, -1, what, q);
+  has_v = lua_getfield(L, 2, "v") != LUA_TNIL;
+  has_p = lua_getfield(L, 2, "p") != LUA_TNIL;
+  if (!has_v && !has_p)
+    luaL_error(L, "%s: the state needs v or p", fname);
+  if (has_p) {
+    snprintf(what, sizeof what, "%s: state.p", fname);
+    dm_lua_system_readvec(L, ls, -1, what, p);
+  }
+  if (has_v) {
+    snprintf(what, sizeof what, "%s: state.v", fname);
+    dm_lua_system_readvec(L, ls, -2, what, v);
+  } else if ((st = dm_integrator_velocity(ls->conv, q, p, v, 0, &e)) != DM_OK) {
+    dm_lua_fail(L, fname, st, &e);
+  }
+  lua_settop(L, 3);
+  return has_p;
 }
 
 static int s_momentum(lua_State *L)
 {
   dm_lsystem *ls = checksys(L);
+  double *p = ls->buf + 2 * ls->n;
   dm_err e;
   int st;
-  read_qx(L, ls, "momentum", "v");
-  double *p = ls->buf + 2 * ls->n;
-  if ((st = dm_integrator_momentum(ls->conv, ls->buf, ls->buf + ls->n, p, &e)) != DM_OK)
+  if (!read_state(L, ls, "momentum")
+      && (st = dm_integrator_momentum(ls->conv, ls->buf, ls->buf + ls->n, p, &e)) != DM_OK)
     return dm_lua_fail(L, "momentum", st, &e);
-  if (!lua_isnoneornil(L, 4)) {
-    lua_pushnumber(L, p[dm_lsystem_checkcoord(L, ls, 4)]);
+  if (!lua_isnoneornil(L, 3)) {
+    lua_pushnumber(L, p[dm_lsystem_checkcoord(L, ls, 3)]);
     return 1;
   }
   dm_pushvec_copy(L, p, ls->n);
   return 1;
 }
 
-static int s_legendre(lua_State *L)
-{
-  lua_settop(L, 3);
-  return s_momentum(L);
-}
-
 static int s_velocity(lua_State *L)
 {
   dm_lsystem *ls = checksys(L);
-  dm_err e;
-  int st;
-  read_qx(L, ls, "velocity", "p");
-  double *v = ls->buf + 2 * ls->n;
-  if ((st = dm_integrator_velocity(ls->conv, ls->buf, ls->buf + ls->n, v, 0, &e)) != DM_OK)
-    return dm_lua_fail(L, "velocity", st, &e);
-  dm_pushvec_copy(L, v, ls->n);
+  read_state(L, ls, "velocity");
+  dm_pushvec_copy(L, ls->buf + ls->n, ls->n);
   return 1;
 }
 
@@ -87,7 +103,7 @@ static int s_energy(lua_State *L)
   dm_err e;
   double E;
   int st;
-  read_qx(L, ls, "energy", "v");
+  read_state(L, ls, "energy");
   if ((st = dm_integrator_energy(ls->conv, ls->buf, ls->buf + ls->n, &E, &e)) != DM_OK)
     return dm_lua_fail(L, "energy", st, &e);
   lua_pushnumber(L, E);
@@ -100,11 +116,11 @@ static int s_lagrangian(lua_State *L)
   dm_lag_out o;
   void *work;
   int st;
-  read_qx(L, ls, "lagrangian", "v");
+  read_state(L, ls, "lagrangian");
   work = lua_newuserdatauv(L, ls->sys.work_size + 8, 0);
   memset(&o, 0, sizeof o);
-  o.Lq = ls->buf + 2 * ls->n;
-  o.Lv = ls->buf + 3 * ls->n;
+  o.Lq = ls->buf + 3 * ls->n;
+  o.Lv = ls->buf + 4 * ls->n;
   st = ls->sys.lagrangian(ls->sys.data, ls->buf, ls->buf + ls->n, ls->sys.par, DM_LAG_L, &o, work);
   if (st < 0)
     return luaL_error(L, "lagrangian: the Lagrangian of '%s' failed (status %d)", ls->sys.name, st);
@@ -431,16 +447,14 @@ static const luaL_Reg system_meta[] = {
 };
 
 static const dm_reg system_methods[] = {
-  {"energy", s_energy, "sys:energy(q, v) -> number",
-   "The energy E = p.v - L at (q, v), p = dL/dv."},
-  {"momentum", s_momentum, "sys:momentum(q, v[, coord]) -> vec | number",
-   "The conjugate momenta p = dL/dv at (q, v), or the component of one coordinate."},
-  {"legendre", s_legendre, "sys:legendre(q, v) -> p",
-   "The Legendre transform p = dL/dv (q, v) (the momenta of a state given by velocities)."},
-  {"velocity", s_velocity, "sys:velocity(q, p) -> v",
-   "The velocity with dL/dv (q, v) = p, by Newton (one step for mechanical L); raises when d2L/dv2 is singular."},
-  {"lagrangian", s_lagrangian, "sys:lagrangian(q, v) -> number",
-   "The value of the Lagrangian at (q, v)."},
+  {"energy", s_energy, "sys:energy{q=, v= | p=} -> number",
+   "The energy E = p.v - L of a state (q and v, or q and p: v then solves dL/dv = p)."},
+  {"momentum", s_momentum, "sys:momentum{q=, v= | p=}[, coord] -> vec | number",
+   "The conjugate momenta p = dL/dv of a state (the Legendre transform), or the component of one coordinate."},
+  {"velocity", s_velocity, "sys:velocity{q=, p= | v=} -> v",
+   "The velocity of a state: v solving dL/dv (q, v) = p by Newton (one step for mechanical L); raises when d2L/dv2 is singular."},
+  {"lagrangian", s_lagrangian, "sys:lagrangian{q=, v= | p=} -> number",
+   "The value of the Lagrangian at a state."},
   {"set", s_set, "sys:set{name = value, ...} -> sys",
    "Change parameters (all checked first); compiled code reads them at once, nothing is recompiled."},
   {NULL, NULL, NULL, NULL}

@@ -40,8 +40,7 @@ T.ok(d < 1e-2 * 9.81 * 0.8, ("pendulum g=9.81 l=0.8, Stormer-Verlet: energy boun
 d = drift(dm.systems.kepler{dim = 3}, {method = "gauss", stages = 2, h = 0.05}, {q = {0.4, 0, 0.1}, p = {0, 2, 0.3}}, 300)
 T.ok(d < 1e-4, ("Kepler 3-D, Gauss 2: energy bounded (%.2g)"):format(d))
 local pol = dm.systems.kepler_polar()
-T.near(pol:energy({0.4, 0.3}, {0, 5}), dm.systems.kepler():energy({0.4 * math.cos(0.3), 0.4 * math.sin(0.3)},
-       {-2 * math.sin(0.3), 2 * math.cos(0.3)}), 1e-15, "Kepler: polar and Cartesian energies agree")
+T.near(pol:energy{q = {0.4, 0.3}, v = {0, 5}}, dm.systems.kepler():energy{q = {0.4 * math.cos(0.3), 0.4 * math.sin(0.3)}, v = {-2 * math.sin(0.3), 2 * math.cos(0.3)}}, 1e-15, "Kepler: polar and Cartesian energies agree")
 d = drift(pol, {method = "lobatto", stages = 3, h = 0.05}, {q = {0.4, 0}, v = {0, 5}}, 300)
 T.ok(d < 1e-4, ("Kepler polar, Lobatto 3: energy bounded (%.2g)"):format(d))
 
@@ -50,9 +49,9 @@ local j2, j2c = dm.systems.j2{J2 = 0.05}, dm.systems.j2_cylindrical{J2 = 0.05}
 local x, y, z = 1.5, 0.4, 0.3
 local R = math.sqrt(x^2 + y^2 + z^2)
 local V = -1 / R + 0.05 / R^3 * (3 * z^2 / (2 * R^2) - 0.5)
-T.near(j2:energy({x, y, z}, {0, 0, 0}), V, 1e-15, "J2: V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (corrected sign)")
-T.near(j2c:energy({math.sqrt(x^2 + y^2), 0.7, z}, {0, 0, 0}), V, 1e-15, "J2 cylindrical: the same potential")
-T.near(j2:energy({x, y, z}, {0.1, 0.2, 0.3}), dm.systems.j2{J2 = 0.05, impl = "c"}:energy({x, y, z}, {0.1, 0.2, 0.3}), 1e-15,
+T.near(j2:energy{q = {x, y, z}, v = {0, 0, 0}}, V, 1e-15, "J2: V = -1/|q| + (J2/|q|^3)(3 z^2/(2|q|^2) - 1/2) (corrected sign)")
+T.near(j2c:energy{q = {math.sqrt(x^2 + y^2), 0.7, z}, v = {0, 0, 0}}, V, 1e-15, "J2 cylindrical: the same potential")
+T.near(j2:energy{q = {x, y, z}, v = {0.1, 0.2, 0.3}}, dm.systems.j2{J2 = 0.05, impl = "c"}:energy{q = {x, y, z}, v = {0.1, 0.2, 0.3}}, 1e-15,
        "J2 catalog = built-in C")
 local rmin, rmax = math.huge, 0
 d, tr = drift(j2, {method = "gauss", stages = 2, h = 0.05}, {q = {2, 0, 0.3}, v = {0, 0.6, 0.1}}, 2000)
@@ -70,7 +69,7 @@ T.ok(math.abs(rc:momentum("theta")[#rc] - 4 * 0.3) < 1e-13, "J2 cylindrical: J =
 -- Henon-Heiles below the escape energy 1/6
 local hh = dm.systems.henon_heiles()
 local s = {q = {0.1, -0.2}, v = {0.3, 0.25}}
-local E0 = hh:energy(s.q, s.v)
+local E0 = hh:energy{q = s.q, v = s.v}
 d = drift(hh, {method = "composition", order = 6, h = 0.05}, s, 2000)
 T.ok(E0 < 1 / 6 and d < 1e-6, ("Henon-Heiles (E = %.4f < 1/6): composition 6 energy error %.2g"):format(E0, d))
 
@@ -80,10 +79,10 @@ local th, ph, thd, phd = 1.2, 0.3, 0.5, 1.5
 local qc = {1.3 * math.sin(th) * math.cos(ph), 1.3 * math.sin(th) * math.sin(ph), -1.3 * math.cos(th)}
 local vc = {1.3 * (math.cos(th) * math.cos(ph) * thd - math.sin(th) * math.sin(ph) * phd),
             1.3 * (math.cos(th) * math.sin(ph) * thd + math.sin(th) * math.cos(ph) * phd), 1.3 * math.sin(th) * thd}
-T.near(sp:energy({th, ph}, {thd, phd}), sp3:energy(qc, vc), 1e-14, "spherical pendulum: angles and R^3 energies agree")
-T.near(dm.systems.spherical_pendulum{l = 1.3}:energy({th, ph}, {thd, phd}),
-       dm.systems.spherical_pendulum{l = 1.3, impl = "c"}:energy({th, ph}, {thd, phd}), 1e-14, "spherical pendulum catalog = built-in C")
-local Esp = math.abs(sp:energy({th, ph}, {thd, phd}))
+T.near(sp:energy{q = {th, ph}, v = {thd, phd}}, sp3:energy{q = qc, v = vc}, 1e-14, "spherical pendulum: angles and R^3 energies agree")
+T.near(dm.systems.spherical_pendulum{l = 1.3}:energy{q = {th, ph}, v = {thd, phd}},
+       dm.systems.spherical_pendulum{l = 1.3, impl = "c"}:energy{q = {th, ph}, v = {thd, phd}}, 1e-14, "spherical pendulum catalog = built-in C")
+local Esp = math.abs(sp:energy{q = {th, ph}, v = {thd, phd}})
 d = drift(sp, {method = "gauss", stages = 2, h = 0.02}, {q = {th, ph}, v = {thd, phd}}, 500)
 T.ok(d < 1e-5 * Esp, ("spherical pendulum, Gauss 2: energy bounded (%.2g)"):format(d))
 d = drift(dm.systems.spherical_pendulum_r3{l = 1.3, m = 2, form = "norm"}, {method = "trapezoid", h = 0.01}, {q = qc, v = vc}, 500)
@@ -98,17 +97,17 @@ local r1, t1, r2, t2 = 0.5, 0.4, 0.45, 1.3
 local r1d, t1d, r2d, t2d = 0.1, 2.5, -0.2, 3.0
 local phi = t2 - t1
 T.is(table.concat(shape.cyclic, ","), "theta", "shape form: theta (simultaneous rotation) is cyclic")
-T.near(cyl:energy({r1, t1, r2, t2}, {r1d, t1d, r2d, t2d}), shape:energy({t1, r1, r2, phi}, {t1d, r1d, r2d, t2d - t1d}),
+T.near(cyl:energy{q = {r1, t1, r2, t2}, v = {r1d, t1d, r2d, t2d}}, shape:energy{q = {t1, r1, r2, phi}, v = {t1d, r1d, r2d, t2d - t1d}},
        1e-14, "cylindrical and shape forms: same energy")
 local I = P.m1 * r1^2 + P.m2 * (r1^2 + r2^2 + 2 * r1 * r2 * math.cos(phi))
 local qs = {t1, r1, r2, phi}
-T.near(shape:momentum(qs, {1, 0, 0, 0}, "theta"), I, 1e-14, "locked inertia I = m1 r1^2 + m2 (r1^2 + r2^2 + 2 r1 r2 cos phi)")
+T.near(shape:momentum({q = qs, v = {1, 0, 0, 0}}, "theta"), I, 1e-14, "locked inertia I = m1 r1^2 + m2 (r1^2 + r2^2 + 2 r1 r2 cos phi)")
 local A = {-r2 * math.sin(phi), r1 * math.sin(phi), r2^2 + r1 * r2 * math.cos(phi)}
 local ok = true
 for i = 1, 3 do
   local e = {0, 0, 0, 0}
   e[i + 1] = 1
-  ok = ok and math.abs(shape:momentum(qs, e, "theta") - P.m2 * A[i]) < 1e-14
+  ok = ok and math.abs(shape:momentum({q = qs, v = e}, "theta") - P.m2 * A[i]) < 1e-14
 end
 T.ok(ok, "mechanical connection I A = m2 (-r2 sin phi, r1 sin phi, r2^2 + r1 r2 cos phi)")
 local function bob(r, t, rd, td, l)
@@ -119,7 +118,7 @@ end
 local x1, w1 = bob(r1, t1, r1d, t1d, P.l1)
 local x2, w2 = bob(r2, t2, r2d, t2d, P.l2)
 local q6, v6 = {x1[1], x1[2], x1[3], x2[1], x2[2], x2[3]}, {w1[1], w1[2], w1[3], w2[1], w2[2], w2[3]}
-T.near(r33:energy(q6, v6), cyl:energy({r1, t1, r2, t2}, {r1d, t1d, r2d, t2d}), 1e-13,
+T.near(r33:energy{q = q6, v = v6}, cyl:energy{q = {r1, t1, r2, t2}, v = {r1d, t1d, r2d, t2d}}, 1e-13,
        "R^3 x R^3 form: same energy at the same configuration")
 d = drift(cyl, {method = "gauss", stages = 2, h = 0.01}, {q = {r1, t1, r2, t2}, v = {r1d, t1d, r2d, t2d}}, 300)
 T.ok(d < 1e-7, ("double spherical pendulum (cylindrical), Gauss 2: energy bounded (%.2g)"):format(d))
@@ -170,8 +169,8 @@ do
     for k in pairs(tr.params) do names[#names + 1] = k .. "=" .. tr.params[k] end
     for k in pairs(cs.params) do same = same and cs.params[k] == tr.params[k] end
     local function agree()
-      local d = math.abs(tr:lagrangian(c[3], c[4]) - cs:lagrangian(c[3], c[4]))
-      local pt, pc = tr:momentum(c[3], c[4]), cs:momentum(c[3], c[4])
+      local d = math.abs(tr:lagrangian{q = c[3], v = c[4]} - cs:lagrangian{q = c[3], v = c[4]})
+      local pt, pc = tr:momentum{q = c[3], v = c[4]}, cs:momentum{q = c[3], v = c[4]}
       for i = 1, #pt do d = math.max(d, math.abs(pt[i] - pc[i])) end
       local st = {q = c[3], v = c[4]}
       local o2 = tr.m > 0 and {method = "lobatto", stages = 3, h = 0.05} or {method = "gauss", stages = 2, h = 0.05}

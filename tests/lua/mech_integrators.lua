@@ -119,7 +119,7 @@ local m1 = mp:step(k0)
 local _, _, Ldm = mp:dlegendre(k0.q, m1.q)
 local qm, vm = (k0.q[1] + m1.q[1]) / 2, {(m1.q[1] - 0.4) / 0.05, (m1.q[2] - 0) / 0.05}
 local qbar = {(0.4 + m1.q[1]) / 2, m1.q[2] / 2}
-T.near(Ldm, 0.05 * kep:lagrangian(qbar, vm), 1e-14, "midpoint Ld = h L((q0+q1)/2, (q1-q0)/h)")
+T.near(Ldm, 0.05 * kep:lagrangian{q = qbar, v = vm}, 1e-14, "midpoint Ld = h L((q0+q1)/2, (q1-q0)/h)")
 T.error_like(function() rk4:dlegendre(k0.q, s1.q) end, "method 'rk4' has no discrete Lagrangian", "rk4 is not variational")
 
 -- discrete momentum J_d along the cyclic angle is conserved

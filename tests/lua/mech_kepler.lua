@@ -10,7 +10,7 @@ local dm = require "dmech"
 
 local kep = dm.systems.kepler()
 local k0 = {q = {0.4, 0}, p = {0, 2}}
-T.near(kep:energy(k0.q, k0.p), -0.5, 1e-15, "H0 = -1/2 (unit mass: v = p)")
+T.near(kep:energy{q = k0.q, p = k0.p}, -0.5, 1e-15, "H0 = -1/2")
 
 -- per-period maxima of |H - H0| and the largest angular-momentum error
 local function analyse(tr, periods)

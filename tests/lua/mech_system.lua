@@ -43,16 +43,16 @@ local q, v = {2.385, 0.3, 0.7}, {0.1, 0.45, -0.2}
 local r, z = q[1], q[3]
 local Lexp = 0.5 * (v[1]^2 + r^2 * v[2]^2 + v[3]^2) - V_j2(r^2 + z^2, z, 0.05)
 local Eexp = 0.5 * (v[1]^2 + r^2 * v[2]^2 + v[3]^2) + V_j2(r^2 + z^2, z, 0.05)
-T.near(sat:lagrangian(q, v), Lexp, 1e-15, "sys:lagrangian")
-T.near(sat:energy(q, v), Eexp, 1e-15, "sys:energy = p.v - L")
-local p = sat:momentum(q, v)
+T.near(sat:lagrangian{q = q, v = v}, Lexp, 1e-15, "sys:lagrangian")
+T.near(sat:energy{q = q, v = v}, Eexp, 1e-15, "sys:energy = p.v - L")
+local p = sat:momentum{q = q, v = v}
 T.ok(math.abs(p[1] - 0.1) < 1e-16 and math.abs(p[2] - r^2 * 0.45) < 1e-15 and math.abs(p[3] + 0.2) < 1e-16,
      "sys:momentum = (rdot, r^2 thetadot, zdot)")
-T.near(sat:momentum(q, v, "theta"), r^2 * 0.45, 1e-15, "sys:momentum(q, v, 'theta') is the component")
-T.near(sat:legendre(dm.vec(q), dm.vec(v))[2], r^2 * 0.45, 1e-15, "sys:legendre with vecs")
-local w = sat:velocity(q, p)
+T.near(sat:momentum({q = q, v = v}, "theta"), r^2 * 0.45, 1e-15, "sys:momentum({q = q, v = v}, 'theta') is the component")
+T.near(sat:momentum{q = dm.vec(q), v = dm.vec(v)}[2], r^2 * 0.45, 1e-15, "sys:momentum with vecs")
+local w = sat:velocity{q = q, p = p}
 T.ok(math.abs(w[1] - 0.1) + math.abs(w[2] - 0.45) + math.abs(w[3] + 0.2) < 1e-15, "sys:velocity inverts the Legendre map")
-T.near(sat:energy({z = 0.7, r = 2.385, theta = 0.3}, v), Eexp, 1e-15, "vectors keyed by coordinate names")
+T.near(sat:energy{q = {z = 0.7, r = 2.385, theta = 0.3}, v = v}, Eexp, 1e-15, "vectors keyed by coordinate names")
 
 -- parameters
 T.is(sat.params.J2, 0.05, "sys.params.J2")
@@ -62,7 +62,7 @@ local names = {}
 for k, x in pairs(sat.params) do names[#names + 1] = k .. "=" .. x end
 T.is(table.concat(names, " "), "J2=0.05", "pairs(sys.params)")
 sat.params.J2 = 1.0826e-3
-T.near(sat:energy(q, v), 0.5 * (v[1]^2 + r^2 * v[2]^2 + v[3]^2) + V_j2(r^2 + z^2, z, 1.0826e-3), 1e-15,
+T.near(sat:energy{q = q, v = v}, 0.5 * (v[1]^2 + r^2 * v[2]^2 + v[3]^2) + V_j2(r^2 + z^2, z, 1.0826e-3), 1e-15,
        "sys.params.J2 = x changes the compiled system at once")
 T.ok(sat:set{J2 = 0.05} == sat and sat.params.J2 == 0.05, "sys:set{...} returns the system")
 T.error_like(function() sat:set{J2 = 1, J3 = 2} end, "no parameter 'J3' in system 'J2 satellite %(cylindrical%)' %(parameters: J2%)",
@@ -98,14 +98,14 @@ end
 local pt = pend(false)
 T.ok(not pt.native and tostring(pt):find("traced, tape"), "native = false runs the tape")
 local pa = pend("auto")
-T.ok(math.abs(pa:energy({1.3}, {0.4}) - pt:energy({1.3}, {0.4})) < 1e-16, "auto (native when a compiler works) = tape")
+T.ok(math.abs(pa:energy{q = {1.3}, v = {0.4}} - pt:energy{q = {1.3}, v = {0.4}}) < 1e-16, "auto (native when a compiler works) = tape")
 
 -- built-in C systems: the same interface, equal values
 local j2c = dm.systems.j2{J2 = 0.05, impl = "c"}
 local j2t = dm.systems.j2{J2 = 0.05}
 local qc, vc = {1.1, -0.4, 0.35}, {0.2, 0.9, 0.15}
-T.near(j2c:energy(qc, vc), j2t:energy(qc, vc), 1e-15, "built-in J2 energy = traced J2 energy")
-T.near(j2c:lagrangian(qc, vc), j2t:lagrangian(qc, vc), 1e-15, "built-in J2 Lagrangian = traced")
+T.near(j2c:energy{q = qc, v = vc}, j2t:energy{q = qc, v = vc}, 1e-15, "built-in J2 energy = traced J2 energy")
+T.near(j2c:lagrangian{q = qc, v = vc}, j2t:lagrangian{q = qc, v = vc}, 1e-15, "built-in J2 Lagrangian = traced")
 T.ok(not j2c.traced and tostring(j2c):find("built%-in C"), "built-ins say so")
 T.error_like(function() return j2c.L end, "system.L: 'J2 satellite %(Cartesian%)' is a built%-in C system without expressions",
              "expressions of a built-in system: clear error (reduction needs a traced system)")
@@ -120,7 +120,7 @@ T.error_like(function() dm.systems.spherical_pendulum_r3{form = "cube", impl = "
 -- the singular Hessian is named
 local sing = dm.system{name = "degenerate", coords = {"x", "y"},
   L = function(q, v) return 0.5 * (v.x + v.y)^2 - 0.5 * (q.x^2 + q.y^2) end}
-T.error_like(function() sing:velocity({0.3, 0.1}, {1, 1}) end,
+T.error_like(function() sing:velocity{q = {0.3, 0.1}, p = {1, 1}} end,
              "d2L/dv2 is singular at q = %(0.3, 0.1%).*the Lagrangian of 'degenerate' is not regular",
              "velocity of a degenerate Lagrangian: singular Hessian named")
 
@@ -158,10 +158,18 @@ err("native must be", "bad native mode", {coords = {"x"}, L = L0, native = "some
 err("constraints of system 'system' must return an expression or a flat list of them, got a nested list",
     "nested constraint list", {coords = {"x"}, L = L0, constraints = function(q) return {{q.x}, {q.x^2}} end})
 T.error_like(function() return sat.nosuch end, "system has no field or method 'nosuch'", "unknown field")
-T.error_like(function() sat:energy({1, 2}, v) end, "energy: q: vector of length 3 expected, got length 2", "wrong size q")
-T.error_like(function() sat:energy({r = 1, theta = 2}, v) end, "energy: q: no value for coordinate 'z'", "missing named coordinate")
-T.error_like(function() sat:energy({r = 1, th = 2, z = 0}, v) end, "energy: q: unknown coordinate th", "unknown named coordinate")
-T.error_like(function() sat:energy(q, "fast") end, "energy: v: vec or table of 3 numbers expected, got string", "wrong type v")
-T.error_like(function() sat:momentum(q, v, "phi") end, "no coordinate 'phi' in system 'J2 satellite %(cylindrical%)' %(coordinates: r, theta, z%)",
+T.error_like(function() sat:energy{q = {1, 2}, v = v} end, "energy: state.q: vector of length 3 expected, got length 2", "wrong size q")
+T.error_like(function() sat:energy{q = {r = 1, theta = 2}, v = v} end, "energy: state.q: no value for coordinate 'z'", "missing named coordinate")
+T.error_like(function() sat:energy{q = {r = 1, th = 2, z = 0}, v = v} end, "energy: state.q: unknown coordinate th", "unknown named coordinate")
+T.error_like(function() sat:energy{q = q, v = "fast"} end, "energy: state.v: vec or table of 3 numbers expected, got string", "wrong type v")
+-- one vocabulary: states are tables, and a state given by momenta works too
+T.error_like(function() sat:energy(q, v) end,
+  "energy: a state {q=, v=} or {q=, p=} expected, got a list %(sys:energy%(q, v%) is written sys:energy{q = q, v = v}%)",
+  "the positional (q, v) form says how to write it now")
+T.error_like(function() sat:momentum{v = v} end, "momentum: the state needs q", "state without q")
+T.error_like(function() sat:lagrangian{q = q} end, "lagrangian: the state needs v or p", "state without v or p")
+T.near(sat:energy{q = q, p = sat:momentum{q = q, v = v}}, Eexp, 1e-14, "energy of a state given by (q, p)")
+T.error_like(function() return sat.legendre end, "system has no field or method .legendre.", "one momentum method: sys:legendre is gone (sys:momentum)")
+T.error_like(function() sat:momentum({q = q, v = v}, "phi") end, "no coordinate 'phi' in system 'J2 satellite %(cylindrical%)' %(coordinates: r, theta, z%)",
              "momentum of an unknown coordinate")
 T.done()

@@ -57,7 +57,7 @@ T.is(#red.constraints, 2, "two constraints on the preshape space")
 T.ok(tostring(red):find("magnetic term beta != 0", 1, true), "non-trivial magnetic term: " .. tostring(red))
 do
   local x = {0.7385, -0.821, 0.3127, -0.4711, -0.6915}
-  local ev = red:eval(x)
+  local ev = red:eval{q = x}
   local Ie = P.m1 * x[1]^2 + P.m2 * ((x[1] + x[3])^2 + x[4]^2)
   T.near(ev.I, Ie, 1e-14, "I = m1 r1^2 + m2 ((r1 + xi2)^2 + eta2^2)")
   local Ae = {-P.m2 * x[4] / Ie, 0, -P.m2 * x[4] / Ie, P.m2 * (x[1] + x[3]) / Ie, 0}
@@ -66,7 +66,7 @@ do
   T.ok(d <= 1e-15, ("A = m2/I (-eta2 dr1 - eta2 dxi2 + (r1 + xi2) deta2) (max diff %.1g)"):format(d))
   -- the singular set: at r1 -> 0 the locked inertia stays regular, Mtilde does not
   local x0 = {1e-4, -1.1, 0.3127, -0.4711, -0.6915}
-  local e0 = red:eval(x0)
+  local e0 = red:eval{q = x0}
   T.ok(e0.I > 0.2, ("at r1 = 1e-4 the locked inertia is regular (I = %.3f): the action is free"):format(e0.I))
   local M = dm.mat(e0.Mtilde)
   local ev2 = M:eig()

@@ -23,7 +23,7 @@ local function thd_hand(r, rd, m) return m * math.sqrt(1 - rd^2) / (r * math.sqr
 do
   local worst = 0
   for _, pt in ipairs{{1.7, 0.2}, {0.6, -0.55}, {2.385, 0.0}, {0.35, 0.8}} do
-    local ev = red:eval({pt[1]}, {pt[2]})
+    local ev = red:eval{q = {pt[1]}, v = {pt[2]}}
     worst = math.max(worst, math.abs(ev.classical - Rc_hand(pt[1], pt[2], mu)) / math.abs(Rc_hand(pt[1], pt[2], mu)),
                      math.abs(ev.thetadot - thd_hand(pt[1], pt[2], mu)) / thd_hand(pt[1], pt[2], mu))
   end
@@ -35,16 +35,16 @@ local hand = dm.system{name = "hand Routhian", coords = {"r"}, params = {k = k, 
   L = function(q, v, p) return -dm.sqrt(1 - v.r^2) * dm.sqrt(1 + p.mu^2 / q.r^2) + p.k / q.r end}
 do   -- momentum and Hessian through the reduced system's conversions
   local x, xd = {1.3}, {0.45}
-  local pr = red.system:momentum(x, xd)[1]
-  local ph = hand:momentum(x, xd)[1]
+  local pr = red.system:momentum{q = x, v = xd}[1]
+  local ph = hand:momentum{q = x, v = xd}[1]
   T.ok(math.abs(pr - ph) <= 1e-14 * math.abs(ph), ("dRc/drdot = hand (%.17g vs %.17g)"):format(pr, ph))
-  local Eh, Er = hand:energy(x, xd), red.system:energy(x, xd)
+  local Eh, Er = hand:energy{q = x, v = xd}, red.system:energy{q = x, v = xd}
   T.ok(math.abs(Er - Eh) <= 1e-14 * math.abs(Eh), ("reduced energy = hand (%.17g vs %.17g)"):format(Er, Eh))
 end
 
 local q0, v0 = {1.4, 0.3}, {0.05, 0.3}
 local st, mu0, th0 = red:project{q = q0, v = v0}
-T.ok(math.abs(mu0 - sys:momentum(q0, v0, "theta")) == 0 and red.mu == mu0, "project: mu = p_theta, set on the reduction")
+T.ok(math.abs(mu0 - sys:momentum({q = q0, v = v0}, "theta")) == 0 and red.mu == mu0, "project: mu = p_theta, set on the reduction")
 hand.params.mu = mu0
 local h, N = 0.02, 1500
 for _, m in ipairs{{"gauss", 2}, {"lobatto", 3}, {"midpoint"}} do
@@ -96,7 +96,7 @@ T.error_like(function()
     force = function(q, v) return {-0.1 * v.r, 0} end}, {cyclic = {"theta"}})
 end, "numerical and does not take a force", "forces need a mechanical L")
 do   -- a shape velocity |rdot| > 1: L, hence J = mu, is undefined
-  local ok, err = pcall(function() return red:eval({1.0}, {1.5}) end)
+  local ok, err = pcall(function() return red:eval{q = {1.0}, v = {1.5}} end)
   T.ok(not ok and tostring(err):find("has no solution thetadot", 1, true), "eval outside the domain: " .. tostring(err))
 end
 T.done()

@@ -27,8 +27,12 @@ do
   local r, z, mu, J2 = 1.7385, 0.4127, 1.1, 0.05
   local R = math.sqrt(r^2 + z^2)
   local V = -1 / R + J2 / R^3 * (1.5 * z^2 / R^2 - 0.5)
-  local ev = red:eval({r, z}, {0.12, -0.31})
+  local ev = red:eval{q = {r, z}, v = {0.12, -0.31}}
   T.near(ev.routhian, 0.5 * (0.12^2 + 0.31^2) - V - mu^2 / (2 * r^2), 1e-14, "numeric Routhian with the centrifugal term")
+  local ep = red:eval{q = {r, z}, p = {0.12, -0.31}}      -- Mtilde = Id here: s = xdot
+  T.near(ep.routhian, ev.routhian, 1e-15, "eval of a reduced state given by (x, s)")
+  T.error_like(function() red:eval({r, z}, {0.12, -0.31}) end,
+    "eval: a reduced state {q = x%[, v = xdot | p = s%]} expected, got a list", "eval takes a state table")
 end
 
 -- double spherical pendulum: closed forms (doc/reduce.md §14) -------------
@@ -46,7 +50,7 @@ do
   local A = {-P.m2 / I * r2 * math.sin(ph), P.m2 / I * r1 * math.sin(ph), P.m2 / I * (r2^2 + r1 * r2 * math.cos(ph))}
   local Vmu = -P.g * (P.m1 * math.sqrt(P.l1^2 - r1^2) + P.m2 * (math.sqrt(P.l1^2 - r1^2) + math.sqrt(P.l2^2 - r2^2)))
     + mu^2 / (2 * I)
-  local ev = rd:eval({r1, r2, ph})
+  local ev = rd:eval{q = {r1, r2, ph}}
   T.near(ev.I, I, 1e-14, "I = m1 r1^2 + m2 (r1^2 + r2^2 + 2 r1 r2 cos phi)")
   local worst = 0
   for i = 1, 3 do worst = math.max(worst, math.abs(ev.A[i] - A[i]) / math.abs(A[i])) end
@@ -83,7 +87,7 @@ do
   T.ok(ok, "dm.routh reduces it (cyclicity decided by evaluation): " .. tostring(rc))
   if ok then
     local x, xd = {0.7385, 0.4127, 2.385}, {0.1, -0.2, 0.3}
-    local a, b = rc:eval(x, xd), rd:eval(x, xd)
+    local a, b = rc:eval{q = x, v = xd}, rd:eval{q = x, v = xd}
     local worst = 0
     for _, k in ipairs{"I", "amended", "routhian", "classical"} do worst = math.max(worst, math.abs(a[k] - b[k]) / math.abs(b[k])) end
     for i = 1, 3 do
@@ -111,7 +115,7 @@ end
 -- reduced integrators through dm.integrator ---------------------------------
 local q0, v0 = {0.3, 0.6, 0.5, 0.3}, {3.3, 0.1, -0.1, 0.2}       -- theta, r1, r2, phi
 local st, mu0, th0 = rd:project{q = q0, v = v0}
-T.near(mu0, dsp:momentum(q0, v0, "theta"), 1e-15, "project: mu = p_theta")
+T.near(mu0, dsp:momentum({q = q0, v = v0}, "theta"), 1e-15, "project: mu = p_theta")
 T.is(th0, 0.3, "project: theta")
 rd:set_mu(mu0)
 T.is(rd.mu, mu0, "set_mu")
@@ -180,7 +184,7 @@ do
   local sp = dm.systems.spherical_pendulum{g = 9.81, l = 1.3, m = 0.7}
   local rsp = dm.routh(sp, {cyclic = {"phi"}, mu = 0.3})
   local q0s, v0s = {0.9, 2.385}, {0.2, 1.7}
-  local mus = sp:momentum(q0s, v0s, "phi")
+  local mus = sp:momentum({q = q0s, v = v0s}, "phi")
   local rst, mu1, ph0 = rsp:project{q = q0s, v = v0s}
   T.ok(math.abs(mu1 - mus) <= 1e-15 * mus and rsp.mu == mu1 and rsp.system.params.mu_phi == mu1,
        ("project sets the reduction's mu to the state's (%.17g; was 0.3)"):format(rsp.mu))
@@ -281,7 +285,7 @@ do
   local Lh, forms = D:lhat(xa, xb)
   T.near(Lh, Ld, 1e-14, ("Lhat(x0, x1) = L_d((0, x0), (psi_mu, x1)) = %.10g"):format(Lh))
   T.near(p1[1], rd.mu, 1e-13, "J_d((0, x0), (psi_mu, x1)) = mu")
-  local sm, sp = D:legendre(xa, xb)
+  local sm, sp = D:dlegendre(xa, xb)
   local proj = rd:project{q = qb, p = s1.p}
   local dl = 0
   for i = 1, 3 do dl = math.max(dl, math.abs(sp[i] - proj.p[i])) end
