@@ -68,7 +68,7 @@ end
 local function case(fig, J2, method, stages, h, every)
   red.system.params.J2 = J2
   local st, mu = red:project{q = q0, v = v0}
-  red:set_mu(mu)
+  red:set{mu = mu}
   local I = dm.integrator(red, {method = method, stages = stages, h = h})
   local steps = math.floor(T / h + 0.5)
   local rt = I:run(st, {steps = steps, every = every})
@@ -124,7 +124,7 @@ do
   red.system.params.J2 = 0.05
   sat.params.J2 = 0.05
   local st, mu = red:project{q = q0, v = v0}
-  red:set_mu(mu)
+  red:set{mu = mu}
   local rt = dm.integrator(red, {method = "midpoint", h = 0.3}):run(st, {steps = 500})
   local full = red:reconstruct(rt, {theta = 0})
   local un = dm.integrator(sat, {method = "midpoint", h = 0.3}):run({q = q0, v = v0}, {steps = 500})

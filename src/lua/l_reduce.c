@@ -376,7 +376,7 @@ void dm_lrouth_push_numbers(lua_State *L, const double *x, size_t n)
 
 static const char *const fields =
   "A, beta, amended, potential, routhian, classical, I, Iinv, Mtilde, M, Iinv_mu, muA, thetadot, "
-  "force, constraints, mu, cyclic, shape, system, full, name, r, s, n";
+  "force, constraints, mu, params, cyclic, shape, system, full, name, r, s, n";
 
 /* fields that exist only for a mechanical L (derived formulas) */
 static int mechanical_only(const char *k)
@@ -442,6 +442,9 @@ static int r_index(lua_State *L)
       push_list(L, x->constraints, x->m);
     else
       lua_pushnil(L);
+  } else if (strcmp(k, "params") == 0) {
+    lua_getiuservalue(L, 1, 1);               /* the reduced System's params proxy */
+    lua_getfield(L, -1, "params");
   } else if (strcmp(k, "mu") == 0)
     dm_lrouth_push_numbers(L, dm_routh_mu(red), x->r);
   else if (strcmp(k, "cyclic") == 0) {
@@ -467,7 +470,7 @@ static int r_index(lua_State *L)
     lua_pushinteger(L, (lua_Integer)x->n);
   else
     return luaL_error(L, "Routh reduction has no field or method '%s' (fields: %s; methods: "
-                      "set_mu, project, lift, reconstruct, phase, eval, discrete, defect, integrator)",
+                      "set, project, lift, reconstruct, phase, eval, discrete, defect, integrator)",
                       k, fields);
   return 1;
 }
@@ -559,7 +562,8 @@ static const struct { const char *name, *doc; } field_docs[] = {
   {"routh.thetadot", "The reconstruction thetadot = I^-1 mu - A xdot."},
   {"routh.force", "The reduced force (thetadot substituted on J = mu), or nil."},
   {"routh.constraints", "The constraints on the preshape space, or nil."},
-  {"routh.mu", "The momentum value (a number for r = 1, else a vec); set with red:set_mu."},
+  {"routh.mu", "The momentum value (a number for r = 1, else a vec); set with red:set{mu = ...}."},
+  {"routh.params", "The parameters of the reduction: the original ones and mu_<theta> (read and assign like sys.params)."},
   {"routh.cyclic", "The names of the cyclic coordinates."},
   {"routh.shape", "The names of the shape (or preshape) coordinates."},
   {"routh.system", "The reduced system (params: the original ones and mu_<theta>) integrated by dm.integrator(red, ...)."},

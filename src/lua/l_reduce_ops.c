@@ -1,5 +1,5 @@
 /* l_reduce_ops.c -- methods of a Routh reduction (see l_reduce.h):
- * red:set_mu, red:project, red:lift, red:reconstruct, red:phase, red:eval,
+ * red:set, red:project, red:lift, red:reconstruct, red:phase, red:eval,
  * red:defect, red:integrator (red:discrete is in l_reduce_dr.c).  Scratch
  * memory lives in userdata, so an argument error never leaks; integrators
  * are made by dm.integrator (one option parser) and live on the stack. */
@@ -204,19 +204,44 @@ static void push_state(lua_State *L, int with_t, double t, const double *q, cons
 
 /* }====================================================================== */
 
-static int m_set_mu(lua_State *L)
+/* red:set{name = value, ..., mu = number | {...}}: the reduced system's
+ * parameters (the original ones and mu_<theta>), mu for all momenta at
+ * once; everything is checked before anything changes.  Through the
+ * reduced System, so its refresh hook and generation count apply. */
+static int m_set(lua_State *L)
 {
   dm_lrouth *u = dm_lrouth_check(L, 1);
   const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
   dm_lsystem *rs = sys_of(L, 1, 1);
   double mu[DM_ROUTH_RMAX];
-  dm_err e;
-  int st;
-  luaL_checkany(L, 2);
-  dm_lrouth_read_mu(L, 2, x->r, mu, "set_mu");
-  if ((st = dm_routh_set_mu(u->red, mu, &e)) != DM_OK)
-    return dm_lua_fail(L, "set_mu", st, &e);
-  rs->gen++;               /* integrators on the reduced system rebuild their caches */
+  int has_mu = 0;
+  size_t a;
+  luaL_checktype(L, 2, LUA_TTABLE);
+  lua_settop(L, 2);
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    if (lua_type(L, -2) == LUA_TSTRING && strcmp(lua_tostring(L, -2), "mu") == 0) {
+      dm_lrouth_read_mu(L, -1, x->r, mu, "set (mu)");
+      has_mu = 1;
+    } else {
+      if (lua_type(L, -2) != LUA_TSTRING)
+        return luaL_error(L, "set: parameter names are strings, got %s", luaL_typename(L, -2));
+      dm_lsystem_checkparam(L, rs, -2);
+      if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
+        return luaL_error(L, "set: parameter '%s' needs a finite number, got %s",
+                          lua_tostring(L, -2), luaL_typename(L, -1));
+    }
+    lua_pop(L, 1);
+  }
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    if (strcmp(lua_tostring(L, -2), "mu") != 0)
+      dm_lua_system_setparam(L, rs, (size_t)dm_lua_system_param(rs, lua_tostring(L, -2)),
+                             lua_tonumber(L, -1));
+    lua_pop(L, 1);
+  }
+  for (a = 0; has_mu && a < x->r; a++)
+    dm_lua_system_setparam(L, rs, x->npar + a, mu[a]);
   lua_settop(L, 1);
   return 1;
 }
@@ -443,8 +468,9 @@ static int m_integrator(lua_State *L)
 }
 
 const dm_reg dm_lrouth_methods[] = {
-  {"set_mu", m_set_mu, "red:set_mu(mu) -> red",
-   "Set the momentum value (a number, or one per cyclic coordinate) without re-deriving anything."},
+  {"set", m_set, "red:set{mu = number | {...}, name = value, ...} -> red",
+   "Change the momentum value (mu: one per cyclic coordinate) and parameters of the reduction "
+   "(red.params: the original ones and mu_<theta>), all checked first, without re-deriving anything."},
   {"project", m_project, "red:project{q=, p= | v= [, t=]} -> reduced_state, mu, theta",
    "Project a full state: x = shape part, s = p_x - mu^T A(x), mu = p_theta (the state's own), theta; "
    "the reduced state is {q = x, p = s, v = xdot}.  The reduction takes the state's mu (red.mu "

@@ -135,6 +135,8 @@ static int s_set(lua_State *L)
   luaL_checktype(L, 2, LUA_TTABLE);
   lua_pushnil(L);
   while (lua_next(L, 2) != 0) {
+    if (lua_type(L, -2) != LUA_TSTRING)
+      return luaL_error(L, "set: parameter names are strings, got %s", luaL_typename(L, -2));
     dm_lsystem_checkparam(L, ls, -2);
     if (lua_type(L, -1) != LUA_TNUMBER)
       return luaL_error(L, "set: parameter '%s' needs a number, got %s", lua_tostring(L, -2),

@@ -81,7 +81,7 @@ do
   local qx, vx = cartesian(P, Q, V)
   local q, v = chart_state(qx, vx)
   local st, mu = red:project{q = q, v = v}
-  red:set_mu(mu)
+  red:set{mu = mu}
   local cart = dm.systems.double_spherical_pendulum_r3(P)
   local hs, err = {0.05, 0.025, 0.0125}, {}
   for j, h in ipairs(hs) do
@@ -111,12 +111,12 @@ do
   local rc = dm.routh(cyl, {cyclic = {"theta"}})
   local q0, v0 = {0, 0.67, 0.36, 0.68}, {1.2, -0.22, 0.24, -0.61}
   local sc, mu = rc:project{q = q0, v = v0}
-  rc:set_mu(mu)
+  rc:set{mu = mu}
   local rb = dm.routh(chart(U), {cyclic = {"theta1"}})
   local qx, vx = cartesian(U, {q0[2], q0[1], q0[3], q0[4]}, {v0[2], v0[1], v0[3], v0[4]})
   local q, v = chart_state(qx, vx)
   local sb, mub = rb:project{q = q, v = v}
-  rb:set_mu(mub)
+  rb:set{mu = mub}
   T.near(mub, mu, 1e-14, "the same momentum in both charts")
   local opt = {method = "lobatto", stages = 3, h = 0.01}
   local a = dm.integrator(rc, opt):run(sc, {steps = 600})

@@ -117,8 +117,30 @@ local q0, v0 = {0.3, 0.6, 0.5, 0.3}, {3.3, 0.1, -0.1, 0.2}       -- theta, r1, r
 local st, mu0, th0 = rd:project{q = q0, v = v0}
 T.near(mu0, dsp:momentum({q = q0, v = v0}, "theta"), 1e-15, "project: mu = p_theta")
 T.is(th0, 0.3, "project: theta")
-rd:set_mu(mu0)
-T.is(rd.mu, mu0, "set_mu")
+rd:set{mu = mu0}
+T.is(rd.mu, mu0, "red:set{mu = ...}")
+T.is(rd.params.mu_theta, mu0, "red.params holds mu_theta")
+do   -- one parameter protocol: params and set, mu included, all checked first
+  local r3 = dm.routh(dm.systems.j2_cylindrical{J2 = 0.05}, {cyclic = {"theta"}, mu = 1.1})
+  local s0 = {q = {1.8, 0.2}, p = {0.0, 0.3}}
+  local I3 = dm.integrator(r3, {method = "gauss", h = 0.05})
+  local a = I3:run(s0, {steps = 20})
+  r3.params.mu_theta = 1.2
+  local b = I3:run(s0, {steps = 20})
+  r3:set{mu = 1.1, J2 = 0.001}
+  local c = I3:run(s0, {steps = 20})
+  r3:set{J2 = 0.05}
+  local d = I3:run(s0, {steps = 20})
+  T.ok(r3.mu == 1.1 and r3.params.J2 == 0.05 and d:column("r")[21] == a:column("r")[21]
+       and b:column("r")[21] ~= a:column("r")[21] and c:column("r")[21] ~= a:column("r")[21],
+       "red.params.mu_theta = x and red:set{mu =, J2 =} reach an existing integrator; setting back restores the run bit for bit")
+  T.error_like(function() r3:set{mu = 1.3, J3 = 1} end, "no parameter 'J3' in system", "set: unknown name")
+  T.ok(r3.mu == 1.1, "set changes nothing when an entry is wrong")
+  T.error_like(function() r3:set{mu = {1, 2}} end, "vector of length 1 expected", "set: mu of the wrong size")
+  T.error_like(function() r3:set{J2 = "x"} end, "set: parameter 'J2' needs a finite number, got string", "set: a non-number")
+  T.error_like(function() r3:set{[1] = 2} end, "set: parameter names are strings, got number", "set: a non-string key")
+  T.error_like(function() return r3.set_mu end, "no field or method 'set_mu'", "one protocol: set_mu is gone")
+end
 T.is(rd.system.params.mu_theta, mu0, "mu is the parameter mu_theta of the reduced system")
 local R = dm.integrator(rd, {method = "gauss", stages = 2, h = 0.01})
 local C = dm.integrator(rd, {method = "classical", stages = 2, h = 0.01})
