@@ -154,7 +154,7 @@ void dm_open_traj(lua_State *L);
 void dm_open_expr(lua_State *L);  /* dm.sym, dm.fn, dm.trace, ... (l_expr.c, l_expr.h) */
 void dm_open_system(lua_State *L);      /* dm.system (l_system.c, l_system.h) */
 void dm_open_builtin(lua_State *L);     /* dm.systems catalog, with its C implementations (l_builtin.c) */
-void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.order_estimate, dm.methods */
+void dm_open_integrator(lua_State *L);  /* dm.integrator, dm.tableau, dm.methods */
 void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
 void dm_open_lie(lua_State *L);         /* dm.lie: Lie groups, systems on groups (l_lie*.c) */
 /* dm.system{space = G, ...}: a system on a Lie group (l_lie_system.c) */

@@ -3,7 +3,7 @@
  * (options and user tableaus),
  * l_integ_run.c (integ:run: the chunked C run loop, progress, trajectory
  * and diagnostic columns) and l_integ_diag.c (dm.tableau,
- * dm.order_estimate, dm.methods).  Not for other bindings.
+ * integ:order_estimate, dm.methods).  Not for other bindings.
  *
  * An Integrator is a userdata "dmech.integrator" holding a dm_linteg; its
  * user value 1 is the System userdata it integrates (kept alive by it),
@@ -74,6 +74,7 @@ void dm_linteg_open_opts(lua_State *L);
 
 /* Lua functions defined in l_integ_run.c / l_integ_diag.c. */
 int dm_linteg_run(lua_State *L);
+int dm_linteg_order_estimate(lua_State *L);   /* l_integ_diag.c */
 
 /* Record the option keys of dm.integrator and integ:run in the docs. */
 void dm_linteg_doc_options(lua_State *L);

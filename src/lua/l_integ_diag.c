@@ -1,5 +1,5 @@
 /* l_integ_diag.c -- dm.tableau (inspect PRK coefficients), dm.methods (the
- * registered integrators) and dm.order_estimate (empirical order by step
+ * registered integrators) and integ:order_estimate (empirical order by step
  * halving against a reference).  Part of the integrator binding. */
 #include <config.h>
 #include <math.h>
@@ -118,31 +118,36 @@ static int l_methods(lua_State *L)
   return 1;
 }
 
-/* dm.order_estimate{system=, method=, stages=, ..., state=, t=, h={...}[, reference=state]} */
-static int l_order_estimate(lua_State *L)
+/* integ:order_estimate{state=, t=, h={...}[, reference=state]}: this
+ * integrator's method and options (its tableau included) at each step */
+int dm_linteg_order_estimate(lua_State *L)
 {
-  static const char *const skip[] = {"system", "state", "t", "h", "reference", NULL};
-  dm_integ_opts opt;
-  dm_lsystem *ls;
+  static const char *const keys[] = {"state", "t", "h", "reference", NULL};
+  dm_linteg *li = dm_linteg_check(L, 1);
+  dm_lsystem *ls = li->ls;
   dm_lstate s, ref;
-  const char *method;
-  double hopt, T, order, *hs, *err, *buf;
-  size_t k, n;
+  double T, order, *hs, *err, *buf;
+  size_t k, n = ls->n;
   dm_err e;
   int st;
-  luaL_checktype(L, 1, LUA_TTABLE);
-  lua_settop(L, 1);
-  lua_getfield(L, 1, "system");                                       /* 2 */
-  if ((ls = dm_lua_tosystem(L, 2)) == NULL)
-    return luaL_error(L, "dm.order_estimate: field 'system' must be a system, got %s",
-                      luaL_typename(L, 2));
-  n = ls->n;
-  dm_linteg_parse(L, 1, "dm.order_estimate", skip, &ls->sys, &opt, &method, &hopt);  /* 3 */
-  T = dm_optnumberfield(L, 1, "t", NAN);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  lua_settop(L, 2);
+  lua_pushnil(L);
+  while (lua_next(L, 2) != 0) {
+    const char *const *kk = keys;
+    while (*kk && !(lua_type(L, -2) == LUA_TSTRING && strcmp(*kk, lua_tostring(L, -2)) == 0))
+      kk++;
+    if (*kk == NULL)
+      return luaL_error(L, "order_estimate: unknown option %s (options: state, t, h, reference; "
+                        "the method and its options are the integrator's)",
+                        luaL_tolstring(L, -2, NULL));
+    lua_pop(L, 1);
+  }
+  T = dm_optnumberfield(L, 2, "t", NAN);
   if (!isfinite(T) || T == 0.0)
-    return luaL_error(L, "dm.order_estimate: field 't' (the final time, != 0) is required");
-  if (lua_getfield(L, 1, "h") != LUA_TTABLE || (k = lua_rawlen(L, -1)) < 2)
-    return luaL_error(L, "dm.order_estimate: field 'h' must list at least 2 step sizes");
+    return luaL_error(L, "order_estimate: field 't' (the final time, != 0) is required");
+  if (lua_getfield(L, 2, "h") != LUA_TTABLE || (k = lua_rawlen(L, -1)) < 2)
+    return luaL_error(L, "order_estimate: field 'h' must list at least 2 step sizes");
   buf = lua_newuserdatauv(L, (2 * k + 8 * n) * sizeof *buf, 0);
   hs = buf;
   err = hs + k;
@@ -150,19 +155,19 @@ static int l_order_estimate(lua_State *L)
     lua_rawgeti(L, -2, (lua_Integer)i + 1);
     hs[i] = lua_tonumber(L, -1);
     if (lua_type(L, -1) != LUA_TNUMBER || !(hs[i] > 0))
-      return luaL_error(L, "dm.order_estimate: h[%d] must be a positive number", (int)i + 1);
+      return luaL_error(L, "order_estimate: h[%d] must be a positive number", (int)i + 1);
     lua_pop(L, 1);
   }
-  if (lua_getfield(L, 1, "state") == LUA_TNIL)
-    return luaL_error(L, "dm.order_estimate: field 'state' (the initial state) is required");
-  dm_lua_readstate(L, ls, ls->conv, -1, "dm.order_estimate", err + k, &s);
+  if (lua_getfield(L, 2, "state") == LUA_TNIL)
+    return luaL_error(L, "order_estimate: field 'state' (the initial state) is required");
+  dm_lua_readstate(L, ls, ls->conv, -1, "order_estimate", err + k, &s);
   ref.q = NULL;
-  if (lua_getfield(L, 1, "reference") != LUA_TNIL)
-    dm_lua_readstate(L, ls, ls->conv, -1, "dm.order_estimate: reference", err + k + 4 * n, &ref);
-  st = dm_integrator_order_estimate(&ls->sys, method, &opt, s.q, s.p, T, hs, k,
+  if (lua_getfield(L, 2, "reference") != LUA_TNIL)
+    dm_lua_readstate(L, ls, ls->conv, -1, "order_estimate: reference", err + k + 4 * n, &ref);
+  st = dm_integrator_order_estimate(&ls->sys, li->method, &li->opt, s.q, s.p, T, hs, k,
                                     ref.q ? ref.q : NULL, ref.q ? ref.p : NULL, err, &order, &e);
   if (st != DM_OK)
-    return dm_lua_fail(L, "dm.order_estimate", st, &e);
+    return dm_lua_fail(L, "order_estimate", st, &e);
   lua_pushnumber(L, order);
   dm_pushvec_copy(L, err, k);
   return 2;
@@ -176,9 +181,5 @@ const dm_reg dm_linteg_diag_funcs[] = {
   {"methods", l_methods, "dm.methods([sys | kind]) -> {name = summary, ...}",
    "The integration methods dm.integrator knows for a kind of system (default: Lagrangian "
    "systems; a system, a Routh reduction, or a kind such as \"routh\"), with one line each."},
-  {"order_estimate", l_order_estimate,
-   "dm.order_estimate{system=, method=, stages=, ..., state=, t=, h={h1, h2, ...}[, reference=state]} -> order, errors",
-   "Integrate to time t with each step size and fit the slope of log(error) against log(h); "
-   "the reference is Gauss 6 (Lobatto 6 with constraints) at h_min/8 unless given."},
   {NULL, NULL, NULL, NULL}
 };

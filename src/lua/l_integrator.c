@@ -3,7 +3,7 @@
  * tables, one step, the discrete Legendre transforms, DEL steps, discrete
  * momentum and the structure diagnostics (symplecticity defect, time
  * reversal, step Jacobian).  integ:run lives in l_integ_run.c, dm.tableau
- * and dm.order_estimate in l_integ_diag.c.  See l_integ.h. */
+ * and integ:order_estimate in l_integ_diag.c.  See l_integ.h. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>
@@ -558,6 +558,11 @@ static const dm_reg integ_methods[] = {
    "integ:discrete_momentum(q0, q1, coord | xi[, h]) -> number",
    "The discrete momentum J_d = xi . D2 Ld(q0, q1) along a coordinate or a direction xi "
    "(conserved by DEL when Ld is invariant)."},
+  {"order_estimate", dm_linteg_order_estimate,
+   "integ:order_estimate{state=, t=, h={h1, h2, ...}[, reference=state]} -> order, errors",
+   "Integrate to time t with this integrator's method and options at each step size and fit the "
+   "slope of log(error) against log(h); the reference is Gauss 6 (Lobatto 6 with constraints) "
+   "at h_min/8 unless given."},
   {"reset", i_reset, "integ:reset() -> integ",
    "Forget the step history (predictor, compensated-summation carries) and the statistics."},
   {NULL, NULL, NULL, NULL}

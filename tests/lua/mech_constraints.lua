@@ -43,10 +43,8 @@ local e = ref[#ref]
 local qr, vr = cart(e.theta, e.phi, e.v_theta, e.v_phi)
 for _, c in ipairs{{{method = "trapezoid"}, 2}, {{method = "lobatto", stages = 3}, 4},
                    {{method = "lobatto", stages = 4}, 6}, {{method = "composition", order = 4}, 4}} do
-  local o = {system = r3, state = {q = q0, v = v0}, t = 2, h = {0.04, 0.02, 0.01, 0.005},
-             reference = {q = qr, p = vr}}
-  for k, x in pairs(c[1]) do o[k] = x end
-  local order, err = dm.order_estimate(o)
+  local order, err = dm.integrator(r3, c[1]):order_estimate{state = {q = q0, v = v0}, t = 2,
+    h = {0.04, 0.02, 0.01, 0.005}, reference = {q = qr, p = vr}}
   T.ok(math.abs(order - c[2]) <= 0.1, ("R^3 %s %s agrees with the angles at order %.3f (expected %d; errors %.2g .. %.2g)"):format(
        c[1].method, c[1].stages or c[1].order or "", order, c[2], err[1], err[4]))
 end
@@ -65,10 +63,8 @@ local function exact(t)
 end
 local xe, ue = exact(4)
 for _, o in ipairs{{{method = "gauss", stages = 2}, 4}, {{method = "midpoint"}, 2}, {{method = "lobatto", stages = 3}, 4}} do
-  local est = {system = damped, state = {q = {x0}, v = {u0}}, t = 4, h = {0.2, 0.1, 0.05, 0.025},
-               reference = {q = {xe}, p = {ue}}}
-  for k, x in pairs(o[1]) do est[k] = x end
-  local order = dm.order_estimate(est)
+  local order = dm.integrator(damped, o[1]):order_estimate{state = {q = {x0}, v = {u0}}, t = 4,
+    h = {0.2, 0.1, 0.05, 0.025}, reference = {q = {xe}, p = {ue}}}
   T.ok(math.abs(order - o[2]) <= 0.1, ("damped oscillator, %s: order %.3f against the exact solution"):format(
        o[1].method, order))
 end

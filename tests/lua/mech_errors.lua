@@ -1,5 +1,5 @@
 -- mech_errors.lua -- every misuse of dm.integrator, its methods,
--- dm.order_estimate and dm.tableau gives a clear error naming what was
+-- integ:order_estimate and dm.tableau gives a clear error naming what was
 -- wrong: unknown methods and options, options of the wrong type or range or
 -- for another method, stages out of range, bad tableaus, wrong state sizes,
 -- NaN states, a singular Hessian at the initial state, bad run options; and
@@ -122,20 +122,20 @@ for _, m in ipairs{"trapezoid", "gauss"} do
        ("%s: leaving the domain of sqrt at step 5 keeps 5 samples: %s"):format(m, msg))
 end
 
--- dm.order_estimate and dm.tableau
+-- integ:order_estimate and dm.tableau
 local pend = dm.systems.pendulum{g = 1}
-err("dm.order_estimate: field 'system' must be a system, got nil", "order_estimate without a system",
-    function() dm.order_estimate{method = "gauss", state = {q = {1}, p = {0.5}}, t = 2, h = {0.1, 0.05}} end)
-err("dm.order_estimate: field 'h' must list at least 2 step sizes", "one step size",
-    function() dm.order_estimate{system = pend, state = {q = {1}, p = {0.5}}, t = 2, h = {0.1}} end)
-err("dm.order_estimate: h%[2%] must be a positive number", "negative step size",
-    function() dm.order_estimate{system = pend, state = {q = {1}, p = {0.5}}, t = 2, h = {0.1, -0.05}} end)
-err("dm.order_estimate: field 't' %(the final time, != 0%) is required", "no t",
-    function() dm.order_estimate{system = pend, state = {q = {1}, p = {0.5}}, h = {0.1, 0.05}} end)
-err("dm.order_estimate: field 'state' %(the initial state%) is required", "no state",
-    function() dm.order_estimate{system = pend, t = 2, h = {0.1, 0.05}} end)
-err("dm.order_estimate: unknown option stage ", "misspelt option in order_estimate",
-    function() dm.order_estimate{system = pend, stage = 2, state = {q = {1}, p = {0.5}}, t = 2, h = {0.1, 0.05}} end)
+local G = dm.integrator(pend, {method = "gauss"})
+err("order_estimate: field 'h' must list at least 2 step sizes", "one step size",
+    function() G:order_estimate{state = {q = {1}, p = {0.5}}, t = 2, h = {0.1}} end)
+err("order_estimate: h%[2%] must be a positive number", "negative step size",
+    function() G:order_estimate{state = {q = {1}, p = {0.5}}, t = 2, h = {0.1, -0.05}} end)
+err("order_estimate: field 't' %(the final time, != 0%) is required", "no t",
+    function() G:order_estimate{state = {q = {1}, p = {0.5}}, h = {0.1, 0.05}} end)
+err("order_estimate: field 'state' %(the initial state%) is required", "no state",
+    function() G:order_estimate{t = 2, h = {0.1, 0.05}} end)
+err("order_estimate: unknown option stages %(options: state, t, h, reference; the method and its options are the integrator's%)",
+    "a method option given to order_estimate", function() G:order_estimate{stages = 2, state = {q = {1}, p = {0.5}}, t = 2, h = {0.1, 0.05}} end)
+T.ok(dm.order_estimate == nil, "one way to estimate an order: the integrator's method")
 err("dm.tableau: gauss needs 1 <= s <= 20 stages, got 0", "Gauss with 0 stages", function() dm.tableau("gauss", 0) end)
 err("dm.tableau: lobatto needs 2 <= s <= 20 stages, got 1", "Lobatto with 1 stage", function() dm.tableau("lobatto", 1) end)
 err("bad argument #1 to 'tableau' %(invalid option 'radau'%)", "unknown tableau family", function() dm.tableau("radau", 3) end)

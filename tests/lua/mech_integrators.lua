@@ -47,17 +47,15 @@ local orders = {
   {{method = "composition", order = 8, scheme = "kahanli8"}, 8, long},
 }
 for _, c in ipairs(orders) do
-  local o = {system = pend, state = s0, t = 2, h = c[3], reference = exact}
-  for k, x in pairs(c[1]) do o[k] = x end
-  local order, err = dm.order_estimate(o)
+  local order, err = dm.integrator(pend, c[1]):order_estimate{state = s0, t = 2, h = c[3], reference = exact}
   T.ok(math.abs(order - c[2]) <= 0.1, ("pendulum order %s %s: order %.3f (expected %d; errors %.3g .. %.3g)"):format(
        c[1].method, c[1].stages or c[1].scheme, order, c[2], err[1], err[#err]))
 end
-local _, g2err = dm.order_estimate{system = pend, method = "gauss", stages = 2, state = s0, t = 2, h = std,
-                                   reference = exact}
+local _, g2err = dm.integrator(pend, {method = "gauss", stages = 2}):order_estimate{state = s0, t = 2, h = std,
+                                                                                  reference = exact}
 T.ok(math.abs(g2err[1] / 1.587e-6 - 1) < 1e-3 and math.abs(g2err[4] / 3.883e-10 - 1) < 1e-3,
      "pendulum G2 errors are the reference 1.587e-6 .. 3.883e-10")
-local order_ref = dm.order_estimate{system = pend, method = "lobatto", stages = 3, state = s0, t = 2, h = std}
+local order_ref = dm.integrator(pend, {method = "lobatto", stages = 3}):order_estimate{state = s0, t = 2, h = std}
 T.ok(math.abs(order_ref - 4) <= 0.1, ("order against the default reference (Gauss 6): %.3f"):format(order_ref))
 
 -- time reversal (doc/integrators.md §12.6) and the symplecticity defect on Kepler e = 0.6

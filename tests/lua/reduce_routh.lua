@@ -238,6 +238,11 @@ do
        :format(maxdiff(tp, t3, cols), maxdiff(tc3, t3, cols)))
   local fp = rd:reconstruct(tp, {theta = 0.3, tableau = g3})
   T.ok(maxdiff(fp, u3, {"theta", "r1"}) <= 1e-12, "reconstruct of a prk run with its tableau")
+  local o4 = dm.integrator(rd, {method = "prk", tableau = dm.tableau("gauss", 2)}):order_estimate{state = st3, t = 1,
+    h = {0.04, 0.02, 0.01}}
+  local o2 = dm.integrator(rd, {method = "dr"}):order_estimate{state = st3, t = 1, h = {0.04, 0.02, 0.01}}
+  T.ok(math.abs(o4 - 4) <= 0.1 and math.abs(o2 - 2) <= 0.1,
+       ("integ:order_estimate on reduced integrators (reference: RSPRK Gauss 6): prk with the Gauss 2 tableau %.3f, dr %.3f"):format(o4, o2))
   T.error_like(function() dm.integrator(rd, {method = "prk", h = 0.02}) end, "dm.integrator: method 'prk' needs a tableau",
     "reduced prk without a tableau")
   T.error_like(function() dm.integrator(rd, {method = "gauss", tableau = g3, h = 0.02}) end,
