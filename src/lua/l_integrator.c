@@ -46,6 +46,8 @@ dm_linteg *dm_linteg_check(lua_State *L, int idx)
   dm_linteg *li = luaL_checkudata(L, idx, DM_INTEG_MT);
   if (li->I == NULL)
     luaL_error(L, "attempt to use a closed integrator");
+  if (li->ls->sys.lagrangian == NULL)
+    luaL_error(L, "attempt to use an integrator whose system was closed");
   if (li->gen != li->ls->gen)
     build(L, li, "integrator (rebuilt after a parameter change)");
   return li;
@@ -61,6 +63,8 @@ dm_lsystem *dm_linteg_checksystem(lua_State *L, int idx)
   dm_lsystem *ls = dm_lua_tosystem(L, idx);
   if (ls != NULL)
     return ls;
+  if (luaL_testudata(L, idx, DM_SYSTEM_MT) != NULL)
+    luaL_error(L, "attempt to use a closed system");
   idx = lua_absindex(L, idx);
   if (luaL_getmetafield(L, idx, "__system") != LUA_TNIL) {
     lua_pushvalue(L, idx);

@@ -28,12 +28,53 @@ static void routh_sys_free(dm_system *s)
   s->data = NULL;
 }
 
+/* 1 when the System in user value uv of the reduction at idx is closed */
+static int closed_sys(lua_State *L, int idx, int uv)
+{
+  dm_lsystem *ls;
+  int closed;
+  lua_getiuservalue(L, idx, uv);
+  ls = luaL_testudata(L, -1, DM_SYSTEM_MT);
+  closed = ls == NULL || ls->sys.lagrangian == NULL;
+  lua_pop(L, 1);
+  return closed;
+}
+
 dm_lrouth *dm_lrouth_check(lua_State *L, int idx)
 {
   dm_lrouth *u = luaL_checkudata(L, idx, DM_ROUTH_MT);
+  idx = lua_absindex(L, idx);
+  if (u->red != NULL && closed_sys(L, idx, 1))
+    u->red = NULL;                /* freed with its reduced system */
   if (u->red == NULL)
-    luaL_error(L, "attempt to use an incomplete Routh reduction");
+    luaL_error(L, "attempt to use a closed Routh reduction");
   return u;
+}
+
+int dm_lrouth_isopen(lua_State *L, int idx)
+{
+  dm_lrouth *u = luaL_testudata(L, idx, DM_ROUTH_MT);
+  idx = lua_absindex(L, idx);
+  if (u == NULL)
+    return 0;
+  if (closed_sys(L, idx, 1))
+    u->red = NULL;
+  return u->red != NULL;
+}
+
+/* __close: close the reduced System, which owns the reduction (its
+ * integrators then refuse to run); idempotent */
+static int r_close(lua_State *L)
+{
+  dm_lrouth *u = luaL_checkudata(L, 1, DM_ROUTH_MT);
+  lua_getiuservalue(L, 1, 1);
+  if (luaL_testudata(L, -1, DM_SYSTEM_MT) != NULL) {
+    lua_replace(L, 1);
+    lua_settop(L, 1);
+    dm_lsystem_gc(L);
+  }
+  u->red = NULL;
+  return 0;
 }
 
 /* {======================================================================
@@ -483,8 +524,10 @@ static int r_tostring(lua_State *L)
   luaL_Buffer b;
   size_t i;
   char num[32];
+  if (closed_sys(L, 1, 1))
+    u->red = NULL;
   if (u->red == NULL) {
-    lua_pushliteral(L, "<routh (incomplete)>");
+    lua_pushliteral(L, "<routh (closed)>");
     return 1;
   }
   x = dm_routh_exprs_get(u->red);
@@ -574,7 +617,7 @@ static const struct { const char *name, *doc; } field_docs[] = {
 void dm_open_reduce(lua_State *L)
 {
   static const luaL_Reg meta[] = {{"__tostring", r_tostring}, {"__system", r_system},
-                                  {NULL, NULL}};
+                                  {"__close", r_close}, {NULL, NULL}};
   size_t i;
   dm_err e;
   if (dm_routh_register_integrators(&e) != DM_OK)

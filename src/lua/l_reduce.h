@@ -23,6 +23,8 @@ typedef struct dm_lrouth {
 } dm_lrouth;
 
 dm_lrouth *dm_lrouth_check(lua_State *L, int idx);
+/* 1 when the value at idx is a reduction whose systems are open */
+int dm_lrouth_isopen(lua_State *L, int idx);
 /* a list of names; numbers as a number (n = 1) or a vec */
 void dm_lrouth_push_names(lua_State *L, const char *const *names, size_t n);
 void dm_lrouth_push_numbers(lua_State *L, const double *x, size_t n);

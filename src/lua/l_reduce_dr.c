@@ -42,6 +42,9 @@ static ldr *check_ldr(lua_State *L)
   ldr *D = luaL_checkudata(L, 1, DR_MT);
   if (D->dr == NULL)
     luaL_error(L, "attempt to use a closed discrete Routh object");
+  lua_getiuservalue(L, 1, 1);
+  dm_lrouth_check(L, -1);          /* raises when the reduction was closed */
+  lua_pop(L, 1);
   return D;
 }
 
@@ -235,7 +238,11 @@ static int ldr_tostring(lua_State *L)
 {
   ldr *D = luaL_checkudata(L, 1, DR_MT);
   char num[32];
-  if (D->dr == NULL) {
+  int open;
+  lua_getiuservalue(L, 1, 1);
+  open = dm_lrouth_isopen(L, -1);
+  lua_pop(L, 1);
+  if (D->dr == NULL || !open) {
     lua_pushliteral(L, "<discrete Routh (closed)>");
     return 1;
   }

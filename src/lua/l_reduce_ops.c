@@ -32,6 +32,8 @@ static dm_lsystem *sys_of(lua_State *L, int idx, int uv)
   lua_getiuservalue(L, idx, uv);
   ls = lua_touserdata(L, -1);
   lua_pop(L, 1);          /* anchored by the reduction */
+  if (ls->sys.lagrangian == NULL)
+    luaL_error(L, "the reduction's %s system was closed", uv == 2 ? "full" : "reduced");
   return ls;
 }
 

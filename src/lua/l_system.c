@@ -58,6 +58,8 @@ dm_lsystem *dm_lua_tosystem(lua_State *L, int idx)
 dm_lsystem *dm_lua_checksystem(lua_State *L, int idx)
 {
   dm_lsystem *ls = dm_lua_tosystem(L, idx);
+  if (ls == NULL && luaL_testudata(L, idx, DM_SYSTEM_MT) != NULL)
+    luaL_error(L, "attempt to use a closed system");
   if (ls == NULL)
     dm_argexpected(L, idx, "system", luaL_typename(L, idx));
   return ls;

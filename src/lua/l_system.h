@@ -12,8 +12,11 @@
  * Ownership: the userdata owns everything in the struct (released by its
  * __gc).  Pointers taken from it (&ls->sys, names, node arrays) stay valid
  * while the userdata is reachable: a binding that keeps one (an integrator)
- * must anchor the System userdata, e.g. in its user value.  There is no
- * __close: a system lives as long as anything refers to it.
+ * must anchor the System userdata, e.g. in its user value.  __close (and
+ * __gc) release everything at once, idempotently: a closed System has
+ * sys.lagrangian == NULL (dm_lua_tosystem returns NULL, checks raise
+ * "attempt to use a closed system"), and objects built on it must test
+ * that before using the pointers they kept.
  *
  * Parameters: ls->sys.par holds the current values (the compiled callbacks
  * read them at every call).  Change them through dm_lua_system_setparam(),

@@ -283,7 +283,7 @@ static int system_index(lua_State *L)
     return 1;
   k = lua_tostring(L, 2);
   if (ls->sys.lagrangian == NULL)
-    return luaL_error(L, "the system is not initialised");
+    return luaL_error(L, "attempt to use a closed system");
   if (strcmp(k, "name") == 0)
     lua_pushstring(L, ls->sys.name);
   else if (strcmp(k, "n") == 0)
@@ -325,7 +325,7 @@ static int system_tostring(lua_State *L)
   luaL_Buffer b;
   char num[32];
   if (ls->sys.lagrangian == NULL) {
-    lua_pushliteral(L, "<system (empty)>");
+    lua_pushliteral(L, "<system (closed)>");
     return 1;
   }
   luaL_buffinit(L, &b);
@@ -370,7 +370,10 @@ static int system_tostring(lua_State *L)
 
 static dm_lsystem *proxy_sys(lua_State *L)
 {
-  return *(dm_lsystem **)luaL_checkudata(L, 1, PARAMS_MT);
+  dm_lsystem *ls = *(dm_lsystem **)luaL_checkudata(L, 1, PARAMS_MT);
+  if (ls->sys.lagrangian == NULL)
+    luaL_error(L, "attempt to use the parameters of a closed system");
+  return ls;
 }
 
 static int params_index(lua_State *L)
@@ -445,7 +448,8 @@ static const luaL_Reg params_meta[] = {
 };
 
 static const luaL_Reg system_meta[] = {
-  {"__gc", dm_lsystem_gc}, {"__tostring", system_tostring}, {NULL, NULL}
+  {"__gc", dm_lsystem_gc}, {"__close", dm_lsystem_gc}, {"__tostring", system_tostring},
+  {NULL, NULL}
 };
 
 static const dm_reg system_methods[] = {

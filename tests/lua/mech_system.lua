@@ -172,4 +172,41 @@ T.near(sat:energy{q = q, p = sat:momentum{q = q, v = v}}, Eexp, 1e-14, "energy o
 T.error_like(function() return sat.legendre end, "system has no field or method .legendre.", "one momentum method: sys:legendre is gone (sys:momentum)")
 T.error_like(function() sat:momentum({q = q, v = v}, "phi") end, "no coordinate 'phi' in system 'J2 satellite %(cylindrical%)' %(coordinates: r, theta, z%)",
              "momentum of an unknown coordinate")
+-- systems get __close (to-be-closed variables): everything is released at
+-- once, idempotently, and what was built on a closed system says so
+do
+  local kept
+  do
+    local sc <close> = dm.systems.pendulum{g = 2.385}
+    kept = sc
+    T.ok(sc:energy{q = {0.3}, v = {0.1}} < 0, "a <close> system works in its scope")
+  end
+  T.is(tostring(kept), "<system (closed)>", "closed at the end of the scope")
+  local s2 = dm.systems.pendulum{}
+  local I2 = dm.integrator(s2, {h = 0.1})
+  local par = s2.params
+  getmetatable(s2).__close(s2)
+  getmetatable(s2).__close(s2)
+  T.error_like(function() return s2.n end, "attempt to use a closed system", "fields of a closed system")
+  T.error_like(function() s2:energy{q = {1}, v = {0}} end, "attempt to use a closed system", "methods of a closed system")
+  T.error_like(function() return par.g end, "attempt to use the parameters of a closed system", "its params proxy")
+  T.error_like(function() I2:step{q = {1}, v = {0}} end, "attempt to use an integrator whose system was closed",
+    "an integrator of a closed system")
+  T.error_like(function() dm.integrator(s2, {}) end, "attempt to use a closed system", "dm.integrator of a closed system")
+  local sp = dm.systems.spherical_pendulum{}
+  local red = dm.routh(sp, {cyclic = {"phi"}, mu = 0.3})
+  local R = dm.integrator(red, {method = "gauss", h = 0.05})
+  local D = red:discrete{h = 0.1}
+  do local _ <close> = red end
+  T.ok(tostring(red) == "<routh (closed)>" and tostring(D) == "<discrete Routh (closed)>", "a Routh reduction closes too")
+  T.error_like(function() return red.mu end, "attempt to use a closed Routh reduction", "fields of a closed reduction")
+  T.error_like(function() R:step{q = {1}, p = {0}} end, "attempt to use an integrator whose system was closed",
+    "its integrators refuse to run")
+  T.error_like(function() D:psi({1}, {1.1}) end, "attempt to use a closed Routh reduction", "its discrete Routh object")
+  local red2 = dm.routh(sp, {cyclic = {"phi"}, mu = 0.3})
+  getmetatable(sp).__close(sp)
+  T.error_like(function() red2:project{q = {1, 0}, v = {0, 1}} end, "the reduction's full system was closed",
+    "a reduction whose full system was closed cannot project full states")
+  T.ok(dm.integrator(red2, {h = 0.1}):step{q = {1}, p = {0}}.q[1] < 1, "but it still integrates: it has its own compiled systems")
+end
 T.done()
