@@ -151,6 +151,9 @@ struct dm_traj *dm_pushtraj(lua_State *L, size_t n, const char *const *coords, u
 struct dm_traj *dm_totraj(lua_State *L, int arg);
 struct dm_traj *dm_checktraj(lua_State *L, int arg);
 void dm_open_traj(lua_State *L);
+/* Mark the Trajectory at arg as a table every MPI rank holds (an ensemble's
+ * result): its save writes on rank 0 only. */
+void dm_traj_mark_replica(lua_State *L, int arg);
 void dm_open_expr(lua_State *L);  /* dm.sym, dm.fn, dm.trace, ... (l_expr.c, l_expr.h) */
 void dm_open_system(lua_State *L);      /* dm.system (l_system.c, l_system.h) */
 void dm_open_builtin(lua_State *L);     /* dm.systems catalog, with its C implementations (l_builtin.c) */
@@ -168,6 +171,7 @@ int dm_lua_integrator(lua_State *L);
 struct dm_integrator *dm_lua_tointegrator(lua_State *L, int idx);
 void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
 void dm_open_conn(lua_State *L);        /* dm.bundle, dm.connection, ... (l_conn*.c) */
+void dm_open_ensemble(lua_State *L);    /* dm.ensemble, dm.mpi, dm.rng (l_ensemble.c) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

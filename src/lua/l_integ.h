@@ -3,7 +3,8 @@
  * (options and user tableaus),
  * l_integ_run.c (integ:run: the chunked C run loop, progress, trajectory
  * and diagnostic columns) and l_integ_diag.c (dm.tableau,
- * integ:order_estimate, dm.methods).  Not for other bindings.
+ * integ:order_estimate, dm.methods); l_ensemble.c (dm.ensemble) reads
+ * integrators and states through it too.  Not for other bindings.
  *
  * An Integrator is a userdata "dmech.integrator" holding a dm_linteg; its
  * user value 1 is the System userdata it integrates (kept alive by it),

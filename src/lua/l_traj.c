@@ -14,13 +14,16 @@
 
 #include "lua/dmlua.h"
 #include "lua/l_traj.h"
+#include "core/mpi.h"
 #include "core/trajectory.h"
+#include "core/trajectory_h5.h"
 
 #define COLS_MT "dmech.trajectory.columns"
 
 typedef struct ltraj {
   dm_traj *tr;
   int busy;            /* a derive is running over it: no close, no derive */
+  int replica;         /* every MPI rank holds the same table: rank 0 saves it */
 } ltraj;
 
 /* {======================================================================
@@ -32,8 +35,15 @@ dm_traj **dm_newtraj(lua_State *L)
   ltraj *u = lua_newuserdatauv(L, sizeof *u, 0);
   u->tr = NULL;
   u->busy = 0;
+  u->replica = 0;
   luaL_setmetatable(L, DM_TRAJ_MT);
   return &u->tr;
+}
+
+void dm_traj_mark_replica(lua_State *L, int arg)
+{
+  ltraj *u = luaL_checkudata(L, arg, DM_TRAJ_MT);
+  u->replica = 1;
 }
 
 dm_traj *dm_pushtraj(lua_State *L, size_t n, const char *const *coords,
@@ -271,9 +281,22 @@ static int t_tostring(lua_State *L)
   }
   len = dm_traj_len(tr);
   luaL_buffinit(L, &b);
-  lua_pushfstring(L, "<Trajectory %I sample%s", (lua_Integer)len, len == 1 ? "" : "s");
-  luaL_addvalue(&b);
-  if (len > 0) {
+  if (dm_traj_meta_get(tr, "members") != NULL && dm_traj_ncoords(tr) == 0) {
+    /* an ensemble's table: one row per member */
+    char names[160];
+    const char *failed = dm_traj_meta_get(tr, "failed");
+    lua_pushfstring(L, "<Ensemble table: %I member%s (%s)", (lua_Integer)len, len == 1 ? "" : "s",
+                    dm_traj_names(tr, names, sizeof names));
+    luaL_addvalue(&b);
+    if (failed != NULL && strcmp(failed, "0") != 0) {
+      lua_pushfstring(L, ", %s failed", failed);
+      luaL_addvalue(&b);
+    }
+  } else {
+    lua_pushfstring(L, "<Trajectory %I sample%s", (lua_Integer)len, len == 1 ? "" : "s");
+    luaL_addvalue(&b);
+  }
+  if (len > 0 && dm_traj_meta_get(tr, "members") == NULL) {
     /* ten digits: the end of a run reads 79289.95, not 79289.95000000001 */
     dm_num_snprintf(a, sizeof a, "%.10g", dm_traj_col(tr, 0)[0]);
     dm_num_snprintf(z, sizeof z, "%.10g", dm_traj_col(tr, 0)[len - 1]);
@@ -570,7 +593,11 @@ static int t_save(lua_State *L)
   dm_traj *tr = dm_checktraj(L, 1);
   const char *path = dm_checkcstring(L, 2);
   dm_err e;
-  if (dm_traj_save(tr, path, &e) != DM_OK) {
+  if (((ltraj *)lua_touserdata(L, 1))->replica && dm_mpi_rank() != 0) {
+    lua_pushboolean(L, 1);       /* rank 0 writes the table every rank holds */
+    return 1;
+  }
+  if (dm_traj_save_any(tr, path, &e) != DM_OK) {
     luaL_pushfail(L);
     lua_pushstring(L, e.msg);
     return 2;
@@ -584,7 +611,7 @@ static int l_load(lua_State *L)
   const char *path = dm_checkcstring(L, 1);
   dm_traj **slot = dm_newtraj(L);
   dm_err e;
-  *slot = dm_traj_load(path, &e);
+  *slot = dm_traj_load_any(path, &e);
   if (*slot == NULL) {
     luaL_pushfail(L);
     lua_pushstring(L, e.msg);
@@ -651,7 +678,7 @@ static const dm_reg traj_methods[] = {
   {"derive", t_derive, "traj:derive(name | {names}, f) -> traj",
    "Add (or recompute) derived columns whose values are f(sample) for every sample."},
   {"save", t_save, "traj:save(file) -> true | nil, message",
-   "Write the trajectory as CSV (%.17g, metadata as comments) atomically through a temporary file."},
+   "Write the trajectory atomically through a temporary file: HDF5 for a name ending in .h5 or .hdf5 (a dataset per column, metadata as attributes), else CSV (%.17g, metadata as comments); an ensemble table under MPI is written by rank 0."},
   {"energy", t_energy, "traj:energy() -> vec",
    "The energy diagnostic column recorded by the integrator."},
   {"momentum", t_momentum, "traj:momentum([name]) -> vec",
@@ -685,7 +712,7 @@ static const luaL_Reg cols_meta[] = {
 
 static const dm_reg traj_funcs[] = {
   {"load_trajectory", l_load, "dm.load_trajectory(file) -> traj | nil, message",
-   "Read a trajectory saved by traj:save (or a plain CSV whose first column is t)."},
+   "Read a trajectory or ensemble table saved by traj:save, CSV or HDF5 (by content), or a plain CSV / HDF5 file with a column t."},
   {NULL, NULL, NULL, NULL}
 };
 

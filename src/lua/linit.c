@@ -19,6 +19,7 @@ static const dm_opener openers[] = {
   dm_open_dec,
   dm_open_lie,
   dm_open_conn,
+  dm_open_ensemble,
   NULL
 };
 

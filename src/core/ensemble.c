@@ -1,0 +1,1042 @@
+/* ensemble.c -- the ensemble driver: members in batches, a pool of worker
+ * threads each with its own integrator, the built-in reducers and chaos
+ * indicators, the user reduction through dm_run, and the MPI split and
+ * gather.  See ensemble.h; the indicators are derived in doc/ensembles.md. */
+#include <config.h>
+#include "core/ensemble.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <gsl/gsl_linalg.h>
+
+#include "core/interrupt.h"
+#include "core/mpi.h"
+#include "core/numfmt.h"
+#include "core/trajectory_h5.h"
+
+static const char *const reducer_names[DM_ENS_NREDUCERS] = {
+  "final", "energy_error", "min_distance", "megno", "fli", "lyapunov"
+};
+
+void dm_ens_opts_init(dm_ens_opts *o)
+{
+  memset(o, 0, sizeof *o);
+  dm_run_opts_init(&o->run);
+  o->run.energy = 0;
+}
+
+const char *dm_ens_reducer_name(int r)
+{
+  return r >= 0 && r < DM_ENS_NREDUCERS ? reducer_names[r] : NULL;
+}
+
+int dm_ens_reducer_find(const char *name)
+{
+  int r;
+  for (r = 0; r < DM_ENS_NREDUCERS; r++)
+    if (strcmp(name, reducer_names[r]) == 0)
+      return r;
+  return -1;
+}
+
+/* murmur3's finalizer: a bijection of 32-bit words with full avalanche */
+static uint32_t fmix32(uint32_t h)
+{
+  h ^= h >> 16;
+  h *= 0x85ebca6bu;
+  h ^= h >> 13;
+  h *= 0xc2b2ae35u;
+  h ^= h >> 16;
+  return h;
+}
+
+unsigned long dm_ens_seed(unsigned long seed, long k)
+{
+  uint32_t base = fmix32((uint32_t)seed ^ fmix32((uint32_t)((uint64_t)seed >> 32) + 0x9e3779b9u));
+  return fmix32(base + (uint32_t)k * 0x9e3779b9u);
+}
+
+static double now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int finite_vec(const double *x, size_t n)
+{
+  double s = 0.0;
+  size_t i;
+  for (i = 0; i < n; i++)
+    s += x[i] * 0.0;
+  return s == 0.0;
+}
+
+/* {==== the ensemble and its workers ===================================== */
+
+typedef struct ens ens;
+
+typedef struct worker {
+  ens *E;
+  pthread_t tid;
+  dm_integrator *I;
+  dm_system sys;            /* a copy with its own parameters (params mode) */
+  dm_sys_pattern pat;
+  double *par, *mass, *pmass, *lag, *work;
+  int have_par;             /* sys.par holds some member's parameters */
+  int running;              /* its thread was started */
+  double *q, *p, *v, *qs, *ps, *D, *d, *dn;
+} worker;
+
+struct ens {
+  const dm_integrator *I0;  /* read only before the first callback */
+  const dm_system *sys;     /* I0's system */
+  char method[2 * DM_INTEG_STRMAX];
+  dm_integ_opts opt;        /* I0's options (copies: the callbacks may rebuild I0) */
+  const dm_ens_opts *o;
+  dm_run_opts run;          /* nsteps resolved */
+  size_t n, npar, nvals;    /* values per row: t, reducers, user, status */
+  size_t col_status;
+  int variational, samples, user;
+  /* this rank's members: k = first + j * stride, j < count */
+  long first, stride, count;
+  double *rows;             /* count x nvals */
+  char **msg;               /* count */
+  /* the batch */
+  long b0, nb;
+  double *q0, *p0, *par0;   /* nb x n, nb x n, nb x npar */
+  dm_traj **traj;           /* nb (user mode) */
+  atomic_long next, done, failed;
+  atomic_int stop;
+  pthread_mutex_t mu;
+  pthread_cond_t cv;
+  int nworkers;
+  worker *w;
+};
+
+static long member_of(const ens *E, long j) { return E->first + j * E->stride; }
+
+/* The member's message, "member <number>: <text>", kept in E->msg. */
+static void member_message(ens *E, long j, const char *fmt, ...)
+#if defined(__GNUC__)
+  __attribute__((format(printf, 3, 4)))
+#endif
+  ;
+
+static void member_message(ens *E, long j, const char *fmt, ...)
+{
+  char text[DM_ERRMSG_MAX + 64];
+  int len;
+  va_list ap;
+  len = snprintf(text, sizeof text, "member %ld: ", member_of(E, j) + E->o->index_base);
+  va_start(ap, fmt);
+  vsnprintf(text + len, sizeof text - (size_t)len, fmt, ap);
+  va_end(ap);
+  free(E->msg[j]);
+  E->msg[j] = strdup(text);    /* NULL when out of memory: the status remains */
+}
+
+static void worker_free(worker *w)
+{
+  dm_integrator_free(w->I);
+  free(w->par);
+  free(w->mass);
+  free(w->pmass);
+  free(w->lag);
+  free(w->work);
+  free(w->q);
+  memset(w, 0, sizeof *w);
+}
+
+/* Buffers, the system copy (params mode) and the integrator. */
+static int worker_init(ens *E, worker *w, dm_err *e)
+{
+  const dm_system *s = E->sys;
+  size_t n = E->n, big = n * n, k;
+  memset(w, 0, sizeof *w);
+  w->E = E;
+  /* q p v qs ps (n each), D (4 n^2), d dn (2n each) */
+  if ((w->q = calloc(5 * n + 4 * n * n + 4 * n + 1, sizeof(double))) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  w->p = w->q + n;
+  w->v = w->p + n;
+  w->qs = w->v + n;
+  w->ps = w->qs + n;
+  w->D = w->ps + n;
+  w->d = w->D + 4 * n * n;
+  w->dn = w->d + 2 * n;
+  if (E->o->params) {
+    w->sys = *s;
+    if (s->pattern != NULL) {
+      w->pat = *s->pattern;
+      w->sys.pattern = &w->pat;
+      if (s->pattern->vv.nnz > big) big = s->pattern->vv.nnz;
+      if (s->pattern->vq.nnz > big) big = s->pattern->vq.nnz;
+      if (s->pattern->qq.nnz > big) big = s->pattern->qq.nnz;
+    }
+    w->par = calloc(E->npar + 1, sizeof(double));
+    w->mass = calloc(n * n + 1, sizeof(double));
+    w->pmass = calloc(big + 1, sizeof(double));
+    w->lag = calloc(2 * n + 3 * big + 1, sizeof(double));
+    w->work = malloc(s->work_size + 8);
+    if (w->par == NULL || w->mass == NULL || w->pmass == NULL || w->lag == NULL
+        || w->work == NULL)
+      return dm_err_set(e, DM_ENOMEM, "out of memory");
+    for (k = 0; k < E->npar; k++)
+      w->par[k] = s->par[k];
+    w->sys.par = w->par;
+    return DM_OK;          /* the integrator is built for the first member */
+  }
+  return dm_integrator_new(s, E->method, &E->opt, &w->I, e);
+}
+
+/* The mass matrix of a separable system at the copy's parameters, through
+ * the system's own callback (Lvv is constant: any q, v = 0); the flag is
+ * dropped when M is not positive definite there. */
+static int refresh_mass(worker *w, const double *q, dm_err *e)
+{
+  const dm_system *s0 = w->E->sys;
+  size_t n = w->E->n, big;
+  dm_lag_out out;
+  double *v = w->v;
+  if (!(s0->flags & DM_SYS_SEPARABLE))
+    return DM_OK;
+  big = n * n;
+  memset(v, 0, n * sizeof *v);
+  memset(&out, 0, sizeof out);
+  out.Lq = w->lag;
+  out.Lv = w->lag + n;
+  out.Lvq = w->lag + 2 * n;
+  out.Lqq = out.Lvq + (w->pat.vq.nnz > big ? w->pat.vq.nnz : big);
+  w->sys.flags = s0->flags;
+  w->sys.mass = NULL;
+  w->pat.mass = NULL;
+  if (s0->mass != NULL) {
+    gsl_matrix_view M;
+    double *C = w->pmass;
+    out.Lvv = w->mass;
+    if (s0->lagrangian(s0->data, q, v, w->par, DM_LAG_VV, &out, w->work) != 0)
+      return dm_err_set(e, DM_EDOM, "the mass matrix cannot be evaluated at these parameters");
+    memcpy(C, w->mass, n * n * sizeof *C);
+    M = gsl_matrix_view_array(C, n, n);
+    if (gsl_linalg_cholesky_decomp1(&M.matrix) != GSL_SUCCESS) {
+      w->sys.flags &= ~(unsigned)DM_SYS_SEPARABLE;
+      return DM_OK;
+    }
+    w->sys.mass = w->mass;
+  }
+  if (s0->pattern != NULL && s0->pattern->mass != NULL) {
+    out.Lvv = w->pmass;
+    if (s0->lagrangian(s0->data, q, v, w->par, DM_LAG_VV | DM_LAG_SPARSE, &out, w->work) != 0)
+      return dm_err_set(e, DM_EDOM, "the mass matrix cannot be evaluated at these parameters");
+    w->pat.mass = w->pmass;
+  }
+  return DM_OK;
+}
+
+/* Ready the worker's integrator for member j (batch slot i): reset, or
+ * rebuilt on the member's parameters. */
+static int prepare(worker *w, long i, dm_err *e)
+{
+  ens *E = w->E;
+  const double *par = E->par0 + (size_t)i * E->npar;
+  int st;
+  if (!E->o->params || (w->have_par && w->I != NULL
+                        && memcmp(par, w->par, E->npar * sizeof *par) == 0)) {
+    dm_integrator_reset(w->I);
+    return DM_OK;
+  }
+  memcpy(w->par, par, E->npar * sizeof *par);
+  w->have_par = 1;
+  dm_integrator_free(w->I);
+  w->I = NULL;
+  if ((st = refresh_mass(w, E->q0 + (size_t)i * E->n, e)) != DM_OK)
+    return st;
+  return dm_integrator_new(&w->sys, E->method, &E->opt, &w->I, e);
+}
+
+/* }====================================================================== */
+
+/* {==== one member with the built-in reducers ============================ */
+
+typedef struct acc {
+  double E0, dE, dmin;
+  double S, Ysum, L, fli;   /* MEGNO and FLI sums */
+} acc;
+
+static double dist_of(const ens *E, const double *q)
+{
+  double s = 0.0;
+  size_t i;
+  for (i = 0; i < E->n; i++)
+    if (E->o->dist == NULL || E->o->dist[i])
+      s += q[i] * q[i];
+  return sqrt(s);
+}
+
+static const char *time_text(const ens *E, long k, char *buf)
+{
+  dm_num_format(buf, DM_NUM_BUFSIZE, E->run.t0 + (double)k * E->run.h);
+  return buf;
+}
+
+/* The state after k steps (q, p): finiteness, energy, distance.  The last
+ * good sample is kept in qs, ps. */
+static int sample(worker *w, long j, long k, acc *a, int first)
+{
+  ens *E = w->E;
+  size_t n = E->n;
+  unsigned r = E->o->reduce;
+  char tb[DM_NUM_BUFSIZE];
+  dm_err le;
+  if (!finite_vec(w->q, n) || !finite_vec(w->p, n)) {
+    member_message(E, j, "the state became non-finite (NaN or Inf) by step %ld of %ld (t = %s): "
+                   "the run diverged", k, E->run.nsteps, time_text(E, k, tb));
+    return DM_EDIVERGED;
+  }
+  if ((r & DM_ENS_BIT(DM_ENS_ENERGY_ERROR)) || E->run.max_energy_error > 0) {
+    double En = NAN;
+    int st = dm_integrator_velocity(w->I, w->q, w->p, w->v, !first, &le);
+    if (st == DM_OK)
+      st = dm_integrator_energy(w->I, w->q, w->v, &En, &le);
+    if (st != DM_OK) {
+      member_message(E, j, "step %ld of %ld (t = %s): no velocity or energy for the state: %s",
+                     k, E->run.nsteps, time_text(E, k, tb), le.msg);
+      return st;
+    }
+    if (first)
+      a->E0 = En;
+    if (!isfinite(En)) {
+      member_message(E, j, "the energy became non-finite at step %ld of %ld (t = %s): the run "
+                     "diverged", k, E->run.nsteps, time_text(E, k, tb));
+      return DM_EDIVERGED;
+    }
+    if (fabs(En - a->E0) > a->dE)
+      a->dE = fabs(En - a->E0);
+    if (E->run.max_energy_error > 0
+        && fabs(En - a->E0) > E->run.max_energy_error * fmax(1.0, fabs(a->E0))) {
+      char x[DM_NUM_BUFSIZE], y[DM_NUM_BUFSIZE];
+      dm_num_format(x, sizeof x, fabs(En - a->E0));
+      dm_num_format(y, sizeof y, E->run.max_energy_error);
+      member_message(E, j, "the energy error |E - E0| = %s exceeds max_energy_error = %s x "
+                     "max(1, |E0|) at step %ld of %ld (t = %s): the run diverged", x, y, k,
+                     E->run.nsteps, time_text(E, k, tb));
+      return DM_EDIVERGED;
+    }
+  }
+  if (r & DM_ENS_BIT(DM_ENS_MIN_DISTANCE)) {
+    double d = dist_of(E, w->q);
+    if (first || d < a->dmin)
+      a->dmin = d;
+  }
+  memcpy(w->qs, w->q, n * sizeof *w->q);
+  memcpy(w->ps, w->p, n * sizeof *w->p);
+  return DM_OK;
+}
+
+/* One step of the state and of the tangent vector d (2n, unit length),
+ * the step into scratch (a failed step leaves its outputs unspecified). */
+static int tangent_step(worker *w, acc *a, long k, dm_err *le)
+{
+  size_t n = w->E->n, N = 2 * n, i, c;
+  double nrm = 0.0, y;
+  int st;
+  if ((st = dm_integrator_jacobian(w->I, w->E->run.h, w->q, w->p, w->D, le)) != DM_OK)
+    return st;
+  if ((st = dm_integrator_step(w->I, w->E->run.h, w->q, w->p, w->dn, w->dn + n, le)) != DM_OK)
+    return st;
+  memcpy(w->q, w->dn, n * sizeof *w->q);
+  memcpy(w->p, w->dn + n, n * sizeof *w->p);
+  for (i = 0; i < N; i++) {
+    double s = 0.0;
+    for (c = 0; c < N; c++)
+      s += w->D[i * N + c] * w->d[c];
+    w->dn[i] = s;
+    nrm += s * s;
+  }
+  nrm = sqrt(nrm);
+  if (!(nrm > 0.0) || !isfinite(nrm))
+    return dm_err_set(le, DM_EDIVERGED, "the tangent vector of the variational equations "
+                      "became %s", nrm == 0.0 ? "zero" : "non-finite");
+  for (i = 0; i < N; i++)
+    w->d[i] = w->dn[i] / nrm;
+  y = log(nrm);
+  a->S += (double)(k + 1) * y;
+  a->Ysum += 2.0 * a->S / (double)(k + 1);
+  a->L += y;
+  if (a->L > a->fli)
+    a->fli = a->L;
+  return DM_OK;
+}
+
+/* Steps from sample to sample; returns the status, *k the steps taken, and
+ * leaves the last good state in qs, ps (its step in *ks). */
+static int member_steps(worker *w, long i, long j, acc *a, long *kout, long *ks)
+{
+  ens *E = w->E;
+  const dm_run_opts *ro = &E->run;
+  long k = 0, N = ro->nsteps;
+  size_t n = E->n, m;
+  char tb[DM_NUM_BUFSIZE];
+  dm_err le;
+  int st;
+  *kout = *ks = 0;
+  memcpy(w->q, E->q0 + (size_t)i * n, n * sizeof *w->q);
+  memcpy(w->p, E->p0 + (size_t)i * n, n * sizeof *w->p);
+  memcpy(w->qs, w->q, n * sizeof *w->q);
+  memcpy(w->ps, w->p, n * sizeof *w->p);
+  dm_err_clear(&le);
+  if ((st = prepare(w, i, &le)) != DM_OK) {
+    member_message(E, j, "%s", le.msg);
+    return st;
+  }
+  for (m = 0; m < 2 * n; m++)
+    w->d[m] = 1.0 / sqrt((double)(2 * n));
+  if ((st = sample(w, j, 0, a, 1)) != DM_OK)
+    return st;
+  while (k < N) {
+    long next = (k / ro->every + 1) * ro->every, got = 0;
+    if (next > N)
+      next = N;
+    dm_err_clear(&le);
+    if (E->variational) {
+      while (k < next && st == DM_OK) {
+        if (dm_interrupted())
+          st = DM_EINTR;
+        else if ((st = tangent_step(w, a, k, &le)) == DM_OK)
+          k++;
+      }
+    } else {
+      st = dm_integrator_advance(w->I, ro->h, next - k, w->q, w->p, &got, &le);
+      k += got;
+    }
+    *kout = k;
+    if (st == DM_EINTR) {
+      member_message(E, j, "interrupted after step %ld of %ld (t = %s)", k, N,
+                     time_text(E, k, tb));
+      break;
+    }
+    if (st != DM_OK) {
+      member_message(E, j, "step %ld of %ld from t = %s failed: %s", k + 1, N,
+                     time_text(E, k, tb), le.msg[0] ? le.msg : dm_strstatus(st));
+      break;
+    }
+    if ((st = sample(w, j, k, a, 0)) != DM_OK)
+      return st;
+    *ks = k;
+  }
+  /* stopped between samples: the state where it stopped is good */
+  if (st != DM_OK && finite_vec(w->q, n) && finite_vec(w->p, n)) {
+    memcpy(w->qs, w->q, n * sizeof *w->q);
+    memcpy(w->ps, w->p, n * sizeof *w->p);
+    *ks = k;
+  }
+  return st;
+}
+
+static void builtin_member(worker *w, long i)
+{
+  ens *E = w->E;
+  const dm_run_opts *ro = &E->run;
+  long j = E->b0 + i, k, ks;
+  size_t n = E->n, c = 0;
+  double *row = E->rows + (size_t)j * E->nvals;
+  unsigned r = E->o->reduce;
+  acc a;
+  int st;
+  memset(&a, 0, sizeof a);
+  st = member_steps(w, i, j, &a, &k, &ks);
+  row[c++] = ro->t0 + (double)ks * ro->h;
+  if (r & DM_ENS_BIT(DM_ENS_FINAL)) {
+    memcpy(row + c, w->qs, n * sizeof *row);
+    memcpy(row + c + n, w->ps, n * sizeof *row);
+    c += 2 * n;
+  }
+  if (r & DM_ENS_BIT(DM_ENS_ENERGY_ERROR))
+    row[c++] = a.dE;
+  if (r & DM_ENS_BIT(DM_ENS_MIN_DISTANCE))
+    row[c++] = a.dmin;
+  if (r & DM_ENS_BIT(DM_ENS_MEGNO))
+    row[c++] = k > 0 ? a.Ysum / (double)k : NAN;
+  if (r & DM_ENS_BIT(DM_ENS_FLI))
+    row[c++] = a.fli;
+  if (r & DM_ENS_BIT(DM_ENS_LYAPUNOV))
+    row[c++] = k > 0 ? a.L / fabs((double)k * ro->h) : NAN;
+  row[E->col_status] = st;
+}
+
+/* }====================================================================== */
+/* {==== one member with a user reduction: a dm_run of its own ============ */
+
+static void user_member(worker *w, long i)
+{
+  ens *E = w->E;
+  long j = E->b0 + i;
+  size_t n = E->n;
+  double *row = E->rows + (size_t)j * E->nvals;
+  dm_run_result res;
+  dm_err le;
+  dm_traj *tr;
+  int st;
+  memcpy(w->q, E->q0 + (size_t)i * n, n * sizeof *w->q);
+  memcpy(w->p, E->p0 + (size_t)i * n, n * sizeof *w->p);
+  row[0] = NAN;
+  if ((st = prepare(w, i, &le)) != DM_OK) {
+    member_message(E, j, "%s", le.msg);
+    row[E->col_status] = st;
+    return;
+  }
+  if ((tr = dm_run_traj_alloc(w->I, &le)) == NULL) {
+    member_message(E, j, "%s", le.msg);
+    row[E->col_status] = le.status;
+    return;
+  }
+  st = dm_run(w->I, w->q, w->p, &E->run, tr, &res, &le);
+  if (st != DM_OK)
+    member_message(E, j, "%s", le.msg);
+  if (res.samples > 0)
+    row[0] = E->run.t0 + (double)res.steps * E->run.h;
+  E->traj[i] = tr;
+  row[E->col_status] = st;
+}
+
+/* }====================================================================== */
+
+/* {==== the pool ========================================================== */
+
+static void *work(void *arg)
+{
+  worker *w = arg;
+  ens *E = w->E;
+  for (;;) {
+    long i;
+    if (atomic_load(&E->stop) || dm_interrupted())
+      break;
+    i = atomic_fetch_add(&E->next, 1);
+    if (i >= E->nb)
+      break;
+    if (E->user)
+      user_member(w, i);
+    else
+      builtin_member(w, i);
+    if (E->rows[(size_t)(E->b0 + i) * E->nvals + E->col_status] != DM_OK)
+      atomic_fetch_add(&E->failed, 1);
+    if (atomic_fetch_add(&E->done, 1) + 1 == E->nb) {
+      pthread_mutex_lock(&E->mu);
+      pthread_cond_signal(&E->cv);
+      pthread_mutex_unlock(&E->mu);
+    }
+  }
+  return NULL;
+}
+
+/* Run the batch on the workers; progress and the stop request from the
+ * calling thread, which runs the members itself if no thread can start. */
+static void run_batch(ens *E, double t_start, long done_before)
+{
+  int t, started = 0;
+  double last = now();
+  atomic_store(&E->next, 0);
+  atomic_store(&E->done, 0);
+  for (t = 0; t < E->nworkers; t++) {
+    E->w[t].running = pthread_create(&E->w[t].tid, NULL, work, &E->w[t]) == 0;
+    started += E->w[t].running;
+  }
+  if (started == 0) {
+    work(&E->w[0]);
+    return;
+  }
+  pthread_mutex_lock(&E->mu);
+  while (atomic_load(&E->done) < E->nb && !atomic_load(&E->stop)) {
+    struct timespec until;
+    double tn;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_nsec += 100000000L;
+    if (until.tv_nsec >= 1000000000L) {
+      until.tv_sec++;
+      until.tv_nsec -= 1000000000L;
+    }
+    pthread_cond_timedwait(&E->cv, &E->mu, &until);
+    if (dm_interrupted())
+      atomic_store(&E->stop, 1);
+    tn = now();
+    if (E->o->progress != NULL && tn - last >= 0.25 && !atomic_load(&E->stop)) {
+      dm_ens_progress pr;
+      last = tn;
+      pr.done = done_before + atomic_load(&E->done);
+      pr.total = E->count;
+      pr.failed = atomic_load(&E->failed);
+      pr.elapsed = tn - t_start;
+      pthread_mutex_unlock(&E->mu);
+      if (E->o->progress(E->o->progress_ctx, &pr) != 0)
+        atomic_store(&E->stop, 1);
+      pthread_mutex_lock(&E->mu);
+    }
+  }
+  pthread_mutex_unlock(&E->mu);
+  for (t = 0; t < E->nworkers; t++)
+    if (E->w[t].running)
+      pthread_join(E->w[t].tid, NULL);
+}
+
+/* }====================================================================== */
+
+/* {==== set-up, the batches, the gather, the table ======================= */
+
+static int check_opts(const dm_integrator *I, const dm_ens_opts *o, dm_run_opts *run,
+                      dm_err *e)
+{
+  unsigned all = (1u << DM_ENS_NREDUCERS) - 1;
+  int st;
+  if (I == NULL || o == NULL)
+    return dm_err_set(e, DM_EINVAL, "need an integrator and options");
+  if (o->members < 1)
+    return dm_err_set(e, DM_EINVAL, "need members >= 1 (got %ld)", o->members);
+  if (o->threads < 0)
+    return dm_err_set(e, DM_EINVAL, "need threads >= 1 (0: automatic), got %d", o->threads);
+  if (o->start == NULL)
+    return dm_err_set(e, DM_EINVAL, "need a start callback for the members' initial states");
+  if (o->reduce & ~all)
+    return dm_err_set(e, DM_EINVAL, "unknown reducer bits 0x%x", o->reduce & ~all);
+  if (o->user != NULL && o->reduce != 0)
+    return dm_err_set(e, DM_EINVAL, "a user reduction is not combined with built-in reducers");
+  if (o->user == NULL && o->nuser != 0)
+    return dm_err_set(e, DM_EINVAL, "user columns without a user reduction");
+  if (o->user != NULL && o->nuser > 0 && o->user_names == NULL)
+    return dm_err_set(e, DM_EINVAL, "the user columns need names");
+  if (o->batch < 0)
+    return dm_err_set(e, DM_EINVAL, "need batch >= 0 (0: automatic)");
+  if ((o->reduce & DM_ENS_VARIATIONAL) && I->m > 0)
+    return dm_err_set(e, DM_EUNSUP, "megno, fli and lyapunov need the step Jacobian, which "
+                      "constrained systems do not have");
+  *run = o->run;
+  run->progress = NULL;
+  run->piece = 0;
+  run->energy = o->user != NULL;
+  if (isfinite(run->t_end) && run->nsteps < 0 && isfinite(run->h) && run->h != 0.0
+      && (st = dm_run_steps_to(run->t0, run->t_end, run->h, &run->nsteps, e)) != DM_OK)
+    return st;
+  if (!isfinite(run->h) || run->h == 0.0)
+    return dm_err_set(e, DM_EINVAL, "need a finite step h != 0");
+  if (!isfinite(run->t0))
+    return dm_err_set(e, DM_EINVAL, "the start time t0 must be finite");
+  if (run->nsteps < 0)
+    return dm_err_set(e, DM_EINVAL, "need steps >= 0 or a final time");
+  if (run->every < 1)
+    return dm_err_set(e, DM_EINVAL, "need every >= 1 (got %ld)", run->every);
+  if (!(run->max_energy_error >= 0))
+    return dm_err_set(e, DM_EINVAL, "max_energy_error must be >= 0");
+  return DM_OK;
+}
+
+/* The empty result table: t, the reducers' columns, the user's, status. */
+static dm_traj *new_table(const ens *E, dm_err *e)
+{
+  const dm_system *s = E->I0->sys;
+  unsigned r = E->o->reduce;
+  dm_traj *tr = dm_traj_alloc(0, NULL, 0, e), *names = NULL;
+  size_t i;
+  int st = DM_OK, k;
+  char buf[DM_TRAJ_NAME_MAX + 8];
+  if (tr == NULL)
+    return NULL;
+  if (r & DM_ENS_BIT(DM_ENS_FINAL)) {
+    /* the coordinate names as a run's trajectory spells them */
+    if ((names = dm_traj_alloc(E->n, s->coords, DM_TRAJ_WITH_P, e)) == NULL) {
+      dm_traj_free(tr);
+      return NULL;
+    }
+    for (i = 1; st == DM_OK && i < 1 + 2 * E->n; i++)
+      st = dm_traj_add_column(tr, dm_traj_colname(names, i), DM_TRAJ_DATA, NULL, 0, e);
+    dm_traj_free(names);
+  }
+  for (k = DM_ENS_ENERGY_ERROR; st == DM_OK && k < DM_ENS_NREDUCERS; k++)
+    if (r & DM_ENS_BIT(k))
+      st = dm_traj_add_column(tr, reducer_names[k], DM_TRAJ_DATA, NULL, 0, e);
+  for (i = 0; st == DM_OK && i < E->o->nuser; i++)
+    st = dm_traj_add_column(tr, E->o->user_names[i], DM_TRAJ_DATA, NULL, 0, e);
+  if (st == DM_OK)
+    st = dm_traj_add_column(tr, "status", DM_TRAJ_DATA, NULL, 0, e);
+  if (st == DM_OK && s->name != NULL)
+    st = dm_traj_meta_set(tr, "system", s->name, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set(tr, "method", E->I0->name, e);
+  if (st == DM_OK && dm_integrator_stages_chosen(E->I0))
+    st = dm_traj_meta_set_number(tr, "stages", E->I0->stages, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "h", E->run.h, e);
+  if (st == DM_OK && E->I0->order > 0)
+    st = dm_traj_meta_set_number(tr, "order", E->I0->order, e);
+  for (i = 0; st == DM_OK && i < s->npar; i++) {
+    snprintf(buf, sizeof buf, "param.%s", s->params ? s->params[i] : "?");
+    st = dm_traj_meta_set_number(tr, buf, s->par[i], e);
+  }
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "members", (double)E->o->members, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "t0", E->run.t0, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "steps", (double)E->run.nsteps, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "every", (double)E->run.every, e);
+  if (st == DM_OK) {
+    char list[256] = "";
+    for (k = 0; k < DM_ENS_NREDUCERS; k++)
+      if (r & DM_ENS_BIT(k))
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? "," : "",
+                 reducer_names[k]);
+    if (E->user)
+      snprintf(list, sizeof list, "user");
+    st = dm_traj_meta_set(tr, "reduce", list, e);
+  }
+  if (st != DM_OK) {
+    dm_traj_free(tr);
+    return NULL;
+  }
+  return tr;
+}
+
+static void ens_free(ens *E)
+{
+  long j;
+  int t;
+  if (E->w != NULL)
+    for (t = 0; t < E->nworkers; t++)
+      worker_free(&E->w[t]);
+  free(E->w);
+  if (E->msg != NULL)
+    for (j = 0; j < E->count; j++)
+      free(E->msg[j]);
+  free(E->msg);
+  free(E->rows);
+  free(E->q0);
+  if (E->traj != NULL)
+    for (j = 0; j < E->nb; j++)
+      dm_traj_free(E->traj[j]);
+  free(E->traj);
+  pthread_mutex_destroy(&E->mu);
+  pthread_cond_destroy(&E->cv);
+}
+
+static int default_threads(void)
+{
+  long c = sysconf(_SC_NPROCESSORS_ONLN);
+  int local = dm_mpi_local_size();
+  if (c < 1)
+    c = 1;
+  c /= local > 0 ? local : 1;
+  return c < 1 ? 1 : (int)c;
+}
+
+/* Start states (and parameters) of the batch from the callback. */
+static int batch_starts(ens *E, dm_err *e)
+{
+  const dm_system *s = E->sys;
+  long i;
+  for (i = 0; i < E->nb; i++) {
+    long j = E->b0 + i;
+    double *row = E->rows + (size_t)j * E->nvals, *par = E->par0 + (size_t)i * E->npar;
+    size_t c;
+    int st;
+    for (c = 0; c < E->nvals; c++)
+      row[c] = NAN;
+    row[E->col_status] = DM_EINTR;      /* until it runs */
+    memcpy(par, s->par, E->npar * sizeof *par);
+    dm_err_clear(e);
+    st = E->o->start(E->o->start_ctx, member_of(E, j), E->q0 + (size_t)i * E->n,
+                     E->p0 + (size_t)i * E->n, E->o->params ? par : NULL, e);
+    if (st != DM_OK) {
+      if (e != NULL && e->msg[0] == '\0')
+        dm_err_set(e, st, "%s", dm_strstatus(st));
+      return st;
+    }
+  }
+  return DM_OK;
+}
+
+/* The user reduction of the batch, in member order. */
+static int batch_user(ens *E, dm_err *e)
+{
+  long i;
+  for (i = 0; i < E->nb; i++) {
+    long j = E->b0 + i;
+    double *row = E->rows + (size_t)j * E->nvals;
+    int st;
+    if (E->traj[i] == NULL)
+      continue;
+    dm_err_clear(e);
+    st = E->o->user(E->o->user_ctx, member_of(E, j), E->traj[i], row + 1, e);
+    dm_traj_free(E->traj[i]);
+    E->traj[i] = NULL;
+    if (st != DM_OK)
+      return st;
+  }
+  return DM_OK;
+}
+
+/* This rank's members, batch by batch. */
+static int run_local(ens *E, dm_err *e)
+{
+  long B = E->o->batch;
+  double t0 = now();
+  int st = DM_OK;
+  if (B == 0)
+    B = E->user ? 16L * E->nworkers : 4096L;
+  for (E->b0 = 0; E->b0 < E->count && st == DM_OK; E->b0 += E->nb) {
+    E->nb = E->count - E->b0 < B ? E->count - E->b0 : B;
+    if ((st = batch_starts(E, e)) != DM_OK)
+      break;
+    if (!atomic_load(&E->stop) && !dm_interrupted())
+      run_batch(E, t0, E->b0);
+    if (E->user && (st = batch_user(E, e)) != DM_OK)
+      break;
+    if (atomic_load(&E->stop) || dm_interrupted()) {
+      /* the rest stays "not run"; rows of later batches are set here */
+      long j, c;
+      for (j = E->b0 + E->nb; j < E->count; j++) {
+        double *row = E->rows + (size_t)j * E->nvals;
+        for (c = 0; c < (long)E->nvals; c++)
+          row[c] = NAN;
+        row[E->col_status] = DM_EINTR;
+      }
+      E->nb = E->count - E->b0;
+      break;
+    }
+  }
+  return st;
+}
+
+/* Pack this rank's messages as records "j\0text\0". */
+static char *pack_messages(const ens *E, size_t *len)
+{
+  size_t total = 0, pos = 0;
+  long j, kept = 0;
+  char *buf;
+  for (j = 0; j < E->count && kept < DM_ENS_MAX_MESSAGES; j++)
+    if (E->msg[j] != NULL && E->rows[(size_t)j * E->nvals + E->col_status] != DM_EINTR) {
+      total += 24 + strlen(E->msg[j]) + 1;
+      kept++;
+    }
+  if ((buf = malloc(total + 1)) == NULL)
+    return NULL;
+  kept = 0;
+  for (j = 0; j < E->count && kept < DM_ENS_MAX_MESSAGES; j++)
+    if (E->msg[j] != NULL && E->rows[(size_t)j * E->nvals + E->col_status] != DM_EINTR) {
+      pos += (size_t)sprintf(buf + pos, "%ld", member_of(E, j)) + 1;
+      pos += (size_t)sprintf(buf + pos, "%s", E->msg[j]) + 1;
+      kept++;
+    }
+  *len = pos;
+  return buf;
+}
+
+static int cmp_long(const void *a, const void *b)
+{
+  long x = *(const long *)a, y = *(const long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Gather every rank's rows and messages and write the table. */
+static int gather(ens *E, dm_traj *tr, long *nfailed, long *nintr, dm_err *e)
+{
+  size_t size = (size_t)(E->o->distributed ? dm_mpi_size() : 1), r, rowb = E->nvals * sizeof(double);
+  size_t *counts = calloc(size, sizeof *counts), len = 0, mlen = 0, pos;
+  char *mine = NULL, *msgs = NULL;
+  void *all = NULL;
+  long M = E->o->members, k, nmsg = 0, failed = 0, intr = 0, *keys = NULL;
+  const double *rows;
+  double **rowp = NULL;
+  int st;
+  if (counts == NULL || (mine = pack_messages(E, &mlen)) == NULL) {
+    free(counts);
+    return dm_err_set(e, DM_ENOMEM, "out of memory");
+  }
+  if (size > 1) {
+    st = dm_mpi_allgather_bytes(E->rows, (size_t)E->count * rowb, &all, &len, counts, e);
+    if (st == DM_OK) {
+      void *m = NULL;
+      st = dm_mpi_allgather_bytes(mine, mlen, &m, &mlen, NULL, e);
+      msgs = m;
+    }
+  } else {
+    all = E->rows;
+    counts[0] = (size_t)E->count * rowb;
+    msgs = mine;
+    st = DM_OK;
+  }
+  if (st == DM_OK && (rowp = malloc((size_t)M * sizeof *rowp)) == NULL)
+    st = dm_err_set(e, DM_ENOMEM, "out of memory");
+  if (st != DM_OK)
+    goto out;
+  /* rank r's j-th row is member r + j size */
+  rows = all;
+  for (r = 0, pos = 0; r < size; r++) {
+    long cnt = (long)(counts[r] / rowb), j;
+    for (j = 0; j < cnt; j++)
+      rowp[(long)r + j * (long)size] = (double *)(rows + (pos / sizeof(double)) + (size_t)j * E->nvals);
+    pos += counts[r];
+  }
+  if ((st = dm_traj_reserve(tr, (size_t)M, e)) != DM_OK)
+    goto out;
+  for (k = 0; k < M && st == DM_OK; k++) {
+    int s = (int)rowp[k][E->col_status];
+    failed += s != DM_OK && s != DM_EINTR;
+    intr += s == DM_EINTR;
+    st = dm_traj_append(tr, rowp[k][0], NULL, NULL, NULL, rowp[k] + 1, e);
+  }
+  /* failure messages in member order */
+  for (pos = 0; pos < mlen; pos += strlen(msgs + pos) + 1)
+    nmsg++;
+  nmsg /= 2;
+  if (st == DM_OK && nmsg > 0 && (keys = malloc((size_t)nmsg * sizeof *keys)) != NULL) {
+    long i = 0;
+    char key[64];
+    for (pos = 0; pos < mlen; i++) {
+      keys[i] = atol(msgs + pos);
+      pos += strlen(msgs + pos) + 1;
+      pos += strlen(msgs + pos) + 1;
+    }
+    qsort(keys, (size_t)nmsg, sizeof *keys, cmp_long);
+    for (i = 0; i < nmsg && i < DM_ENS_MAX_MESSAGES && st == DM_OK; i++)
+      for (pos = 0; pos < mlen;) {
+        long kk = atol(msgs + pos);
+        pos += strlen(msgs + pos) + 1;
+        if (kk == keys[i]) {
+          snprintf(key, sizeof key, "failure.%ld", kk + E->o->index_base);
+          st = dm_traj_meta_set(tr, key, msgs + pos, e);
+          break;
+        }
+        pos += strlen(msgs + pos) + 1;
+      }
+  }
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "failed", (double)failed, e);
+  if (st == DM_OK)
+    st = dm_traj_meta_set_number(tr, "interrupted", (double)intr, e);
+  *nfailed = failed;
+  *nintr = intr;
+out:
+  if (all != E->rows)
+    free(all);
+  if (msgs != mine)
+    free(msgs);
+  free(mine);
+  free(keys);
+  free(rowp);
+  free(counts);
+  return st;
+}
+
+int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
+                    dm_ens_summary *sum, dm_err *e)
+{
+  ens E;
+  dm_traj *tr = NULL;
+  dm_err le;
+  double t0 = now();
+  int st, t, size = 1, rank = 0;
+  long failed = 0, intr = 0;
+  *out = NULL;
+  if (sum != NULL)
+    memset(sum, 0, sizeof *sum);
+  memset(&E, 0, sizeof E);
+  pthread_mutex_init(&E.mu, NULL);
+  pthread_cond_init(&E.cv, NULL);
+  if (e == NULL)
+    e = &le;
+  dm_err_clear(e);
+  if ((st = check_opts(I, o, &E.run, e)) != DM_OK)
+    goto fail;            /* the same on every rank: nobody waits */
+  E.I0 = I;
+  E.sys = I->sys;
+  snprintf(E.method, sizeof E.method, "%s", I->name);
+  E.opt = I->opt;
+  E.o = o;
+  E.n = I->n;
+  E.npar = I->sys->npar;
+  E.user = o->user != NULL;
+  E.variational = (o->reduce & DM_ENS_VARIATIONAL) != 0;
+  E.nvals = 1 + o->nuser + 1;
+  if (o->reduce & DM_ENS_BIT(DM_ENS_FINAL))
+    E.nvals += 2 * E.n;
+  for (t = DM_ENS_ENERGY_ERROR; t < DM_ENS_NREDUCERS; t++)
+    E.nvals += (o->reduce & DM_ENS_BIT(t)) != 0;
+  E.col_status = E.nvals - 1;
+  if (o->distributed) {
+    size = dm_mpi_size();
+    rank = dm_mpi_rank();
+  }
+  E.first = rank;
+  E.stride = size;
+  E.count = o->members > rank ? (o->members - rank + size - 1) / size : 0;
+  E.nworkers = o->threads > 0 ? o->threads : default_threads();
+  if (E.nworkers > E.count)
+    E.nworkers = E.count > 0 ? (int)E.count : 1;
+  /* from here on every rank reaches the agreement below */
+  if ((tr = new_table(&E, e)) == NULL)
+    st = e->status;
+  if (st == DM_OK) {
+    long B = o->batch > 0 ? o->batch : E.user ? 16L * E.nworkers : 4096L;
+    size_t nb = (size_t)(B < E.count ? B : E.count > 0 ? E.count : 1);
+    E.rows = malloc(((size_t)E.count + 1) * E.nvals * sizeof *E.rows);
+    E.msg = calloc((size_t)E.count + 1, sizeof *E.msg);
+    E.q0 = malloc((nb * (2 * E.n + E.npar) + 1) * sizeof *E.q0);
+    E.traj = E.user ? calloc(nb, sizeof *E.traj) : NULL;
+    E.w = calloc((size_t)E.nworkers, sizeof *E.w);
+    if (E.rows == NULL || E.msg == NULL || E.q0 == NULL || (E.user && E.traj == NULL)
+        || E.w == NULL) {
+      st = dm_err_set(e, DM_ENOMEM, "out of memory for %ld members", E.count);
+    } else {
+      E.p0 = E.q0 + nb * E.n;
+      E.par0 = E.p0 + nb * E.n;
+    }
+  }
+  for (t = 0; st == DM_OK && t < E.nworkers; t++)
+    st = worker_init(&E, &E.w[t], e);
+  if (st == DM_OK)
+    st = run_local(&E, e);
+  if (o->distributed)
+    st = dm_mpi_agree(st, e);
+  if (st == DM_OK)
+    st = gather(&E, tr, &failed, &intr, e);
+  if (st != DM_OK)
+    goto fail;
+  ens_free(&E);
+  *out = tr;
+  st = intr > 0 ? DM_EINTR : DM_OK;
+  if (o->output != NULL) {
+    int ws = o->distributed ? dm_traj_save_h5_shared(tr, o->output, &le)
+                            : dm_traj_save_h5(tr, o->output, &le);
+    if (ws != DM_OK) {
+      *e = le;
+      st = ws;
+    }
+  }
+  if (st == DM_EINTR)
+    dm_err_set(e, DM_EINTR, "interrupted: %ld of %ld members finished; they are kept",
+               o->members - intr, o->members);
+  if (sum != NULL) {
+    sum->members = o->members;
+    sum->done = o->members - intr;
+    sum->failed = failed;
+    sum->status = st;
+    sum->elapsed = now() - t0;
+  }
+  return st;
+fail:
+  ens_free(&E);
+  dm_traj_free(tr);
+  if (sum != NULL)
+    sum->status = st;
+  return st;
+}
+
+/* }====================================================================== */
