@@ -21,6 +21,7 @@
 
 #include "core/cleanup.h"
 #include "core/interrupt.h"
+#include "core/mpi.h"
 #include "lua/dmlua.h"
 #include "app/repl.h"
 #include "app/testrun.h"
@@ -380,6 +381,8 @@ int main(int argc, char **argv)
   status = lua_pcall(L, 2, 1, 0);
   result = lua_toboolean(L, -1);
   dm_report(L, status);
+  if (!(result && status == LUA_OK))
+    dm_mpi_fail(EXIT_FAILURE);    /* under mpirun: end every rank, none left waiting */
   lua_close(L);
   return (result && status == LUA_OK) ? EXIT_SUCCESS : EXIT_FAILURE;
 }

@@ -72,5 +72,12 @@ status=$?
 like "$out" "no start for member 4 on rank 1" "a Lua error on rank 1 is reported"
 ok "$([ $status -ne 0 ] && [ $status -ne 124 ] && echo 0 || echo 1)" \
   "and the job ends with a failure, not a hang (status $status)"
+printf '%s\n' 'if dm.mpi.rank() == 1 then error("rank 1 gives up") end' \
+  'dm.mpi.barrier()' 'print("rank " .. dm.mpi.rank() .. " passed the barrier")' > "$tmp/gives_up.lua"
+out=$(run_mpi "$DMECH" "$tmp/gives_up.lua" 2>&1)
+status=$?
+like "$out" "rank 1 gives up" "an error outside dm.ensemble on one rank"
+ok "$([ $status -ne 0 ] && [ $status -ne 124 ] && ! printf '%s' "$out" | grep -q passed && echo 0 || echo 1)" \
+  "ends the job (MPI_Abort) instead of leaving rank 0 at the barrier (status $status)"
 rm -rf "$tmp"
 done_testing
