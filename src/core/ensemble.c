@@ -726,6 +726,17 @@ static void ens_free(ens *E)
   pthread_cond_destroy(&E->cv);
 }
 
+static int wait_for_code(const dm_system *sys, dm_err *e)
+{
+  struct timespec pause = {0, 5000000L};
+  while (sys->update != NULL && sys->update(sys)) {
+    if (dm_interrupted())
+      return dm_err_set(e, DM_EINTR, "interrupted while the system's code was being compiled");
+    nanosleep(&pause, NULL);
+  }
+  return DM_OK;
+}
+
 static int default_threads(void)
 {
   long c = sysconf(_SC_NPROCESSORS_ONLN);
@@ -955,6 +966,12 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
   dm_err_clear(e);
   if ((st = check_opts(I, o, &E.run, e)) != DM_OK)
     goto fail;            /* the same on every rank: nobody waits */
+  /* code being compiled in the background: installed before any member
+   * runs, so that every member runs the same code (a switch half-way would
+   * change the last bits of some members, and update() must not run while
+   * the workers use the system) */
+  if ((st = wait_for_code(I->sys, e)) != DM_OK)
+    goto fail;
   E.I0 = I;
   E.sys = I->sys;
   snprintf(E.method, sizeof E.method, "%s", I->name);

@@ -84,6 +84,9 @@
  * matrix of a separable system re-evaluated through the system's
  * callbacks), and the integrator copy is rebuilt when the values change.
  *
+ * Code compiled in the background (system.h: update) is waited for and
+ * installed before the first member, so every member runs the same code.
+ *
  * Threads.  `threads` workers (0: the online processors, divided among
  * the MPI ranks of this node) take members one at a time; the callbacks
  * run in the calling thread only, between batches of members.  The

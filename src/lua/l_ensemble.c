@@ -27,7 +27,6 @@
 #include "core/interrupt.h"
 #include "core/mpi.h"
 #include "core/trajectory_h5.h"
-#include "expr/lagrangian.h"
 
 #define RNG_MT "dmech.rng"
 
@@ -229,8 +228,8 @@ static void restore_params(call *c)
     }
   if (changed) {
     c->ls->gen++;
-    if (c->ls->traced)
-      dm_lagrangian_refresh(&c->ls->sys, NULL);
+    if (c->ls->sys.refresh != NULL)
+      c->ls->sys.refresh(&c->ls->sys, NULL);
   }
 }
 
@@ -290,9 +289,12 @@ static int protect(call *c, lua_CFunction body, dm_err *e)
   for (i = 1; i <= A_TOP; i++)
     lua_pushvalue(L, i);
   if (lua_pcall(L, 1 + A_TOP, 0, 0) != LUA_OK) {
+    /* the text travels to the other MPI ranks; this rank re-raises the value */
+    const char *msg = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+    dm_err_set(e, DM_ECALLBACK, "%s", msg != NULL ? msg : "a Lua function raised a non-string error");
     lua_replace(L, A_ERR);
     lua_settop(L, top);
-    return dm_err_set(e, DM_ECALLBACK, "a Lua function failed");
+    return DM_ECALLBACK;
   }
   lua_settop(L, top);
   return DM_OK;

@@ -23,7 +23,7 @@ run_mpi() {
 
 cat > "$tmp/sweep.lua" <<'EOF'
 local dir, threads = arg[1], tonumber(arg[2])
-local I = dm.integrator(dm.builtin.kepler(), {method = "gauss", stages = 2, h = 0.01})
+local I = dm.integrator(dm.systems.kepler{impl = "c"}, {method = "gauss", stages = 2, h = 0.01})
 local res, msg = dm.ensemble{integrator = I, members = 37, threads = threads, run = {t = 2},
   seed = 2385, output = dir .. "/out.h5",
   states = function(k, rng)
@@ -61,7 +61,7 @@ is "$(ls "$tmp/two")" "out.h5
 saved.h5" "one file each, no temporary files left"
 
 cat > "$tmp/fail.lua" <<'EOF'
-local I = dm.integrator(dm.builtin.kepler(), {method = "gauss", h = 0.01})
+local I = dm.integrator(dm.systems.kepler{impl = "c"}, {method = "gauss", h = 0.01})
 dm.ensemble{integrator = I, members = 6, run = {steps = 10},
   states = function(k)
     if k == 4 then error("no start for member 4 on rank " .. dm.mpi.rank()) end
