@@ -357,6 +357,21 @@ function M._hint(msg, info)
   if word then return mean(nearest(word, split_list(list)), "\"%s\"") end
   word, list = msg:match("unknown coordinate '?([%w_]+)'? %(coordinates: ([^)]*)%)")
   if word then return mean(nearest(word, split_list(list))) end
+  -- p.m, v.y in L: a parameter not declared, a coordinate misspelt
+  local vec
+  word, vec, list = msg:match("no element '([%w_]+)' in ([%w_]+) %(elements: ([^)]*)%)")
+  if word then
+    local cands = {}
+    for _, e in ipairs(split_list(list)) do cands[#cands + 1] = (e:gsub("^v_", "")) end
+    local near = nearest(word, cands)
+    if vec == "p" then
+      local s = string.format("parameters are declared in dm.system{params = {%s = ...}} and read as p.%s",
+                              word, word)
+      if #near > 0 then s = mean(near) .. "; " .. s end
+      return s
+    end
+    return mean(near)
+  end
   local cls
   cls, word, list = msg:match("([%w_]+) has no field or method '([^']+)' %(fields: ([^)]*)%)")
   if word then

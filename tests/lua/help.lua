@@ -116,6 +116,13 @@ T.is(hint("attempt to perform arithmetic on a nil value (global 'mass')",
           {traceback = "stack traceback:\n\t[C]: in function 'dmech.system'"}),
      "\nhint: 'mass' is not defined (a nil global); in L, a parameter is declared in params = {mass = ...} and read as p.mass",
      "an undefined global inside L is named with the params recipe")
+T.is(hint("no element 'm' in p (elements: )"),
+     "\nhint: parameters are declared in dm.system{params = {m = ...}} and read as p.m",
+     "an undeclared parameter in L")
+T.is(hint("no element 'thta' in q (elements: r, theta)"), "\nhint: did you mean 'theta'?",
+     "a misspelt coordinate in L")
+T.is(hint("no element 'thta' in v (elements: v_r, v_theta)"), "\nhint: did you mean 'theta'?",
+     "a misspelt velocity in L")
 T.is(hint("attempt to call a nil value (global 'prnt')"),
      "\nhint: 'prnt' is not defined (a nil global); did you mean 'print'?", "misspelt global")
 T.is(hint("attempt to call a nil value (global 'linspace')"),
