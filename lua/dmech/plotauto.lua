@@ -101,7 +101,11 @@ local CORNERS = {
   {"top center", 0.5, 1}, {"bottom center", 0.5, 0},
 }
 
--- The size of the key box as fractions of the plot area (kw, kh).
+local CORNERS = {
+  {"top right", 1, 1}, {"top left", 0, 1}, {"bottom right", 1, 0}, {"bottom left", 0, 0},
+  {"top center", 0.5, 1}, {"bottom center", 0.5, 0},
+}
+
 -- The plot area of one panel and the font's metrics: pngcairo's default
 -- font is about 8 pixels a character and 19 a key line, the margins about
 -- 110 x 100 pixels (characters for text terminals).
@@ -115,12 +119,12 @@ local function panel_area(target, layout)
   return math.max(W - mw, 4 * cw), math.max(H - mh, 2 * lh), cw, lh
 end
 
--- The size of the key box as fractions of the plot area (kw, kh).
-local function key_size(titles, target, layout)
-  local pw, ph, cw, lh = panel_area(target, layout)
+-- The size of the key box as fractions of the frame (fw x fh; cw, lh: the
+-- character width and line height).
+local function key_size(titles, fw, fh, cw, lh)
   local maxlen = 0
   for _, t in ipairs(titles) do maxlen = math.max(maxlen, utf8.len(t) or #t) end
-  return (maxlen * cw + 9 * cw) / pw, (#titles * lh + lh / 2) / ph
+  return (maxlen * cw + 9 * cw) / fw, (#titles * lh + lh / 2) / fh
 end
 
 -- A tic step for [a, b] whose labels fit in `avail` (pixels) at `size`
@@ -154,13 +158,11 @@ local function thin_tics(a, b, step, avail, label_size)
 end
 
 -- Where the key of a 2-D panel goes: the first corner whose box no point
--- or segment of the data enters (in the ranges gnuplot will draw), else
--- below the plot.
-local function place_key(samples, styles, titles, target, layout, o, logs)
-  local kw, kh = key_size(titles, target, layout)
-  local lo, hi = bounds(samples, 2)
-  lo[1], hi[1] = drawn_range(lo[1], hi[1], o.xrange, logs[1])
-  lo[2], hi[2] = drawn_range(lo[2], hi[2], o.yrange, logs[2])
+-- or segment of the data enters (in the ranges gnuplot will draw: rx, ry),
+-- else room made above the data (a headroom fraction is returned too),
+-- else below the plot.
+local function place_key(samples, styles, kw, kh, rx, ry, o)
+  local lo, hi = {rx[1], ry[1]}, {rx[2], ry[2]}
   if not (lo[1] < hi[1]) or not (lo[2] < hi[2]) or kw > 0.7 or kh > 0.8 then
     return "below"
   end
@@ -251,66 +253,83 @@ local function panel_defaults(p, pb, o, target, layout)
     end
     if p.series[i].title and p.series[i].title ~= "" then titles[#titles + 1] = p.series[i].title end
   end
-  -- equal aspect for configuration-space pictures of comparable spans
-  if o.aspect == nil and lg == "" and #samples > 0 and all_positions(p) then
-    local lo, hi = bounds(samples, dims)
-    local smin, smax = math.huge, 0
-    for j = 1, dims do
-      local sp = hi[j] - lo[j]
-      smin, smax = math.min(smin, sp), math.max(smax, sp)
+  if #samples == 0 then return auto end
+  local pw, ph, cw, lh = panel_area(target, layout)
+  local lo, hi = bounds(samples, dims)
+  local rng, step = {}, {}
+  for j, a in ipairs{"x", "y", "z"} do
+    if j <= dims then
+      local ra, rb, st = drawn_range(lo[j], hi[j], o[a .. "range"], logs[j])
+      rng[j], step[j] = {ra, rb}, st
     end
-    if smin > 0 and smax / smin <= 4 then auto.aspect = "equal" end
   end
-  if o.key == nil and dims == 2 and #titles > 0 and #samples > 0 then
-    auto.key, auto.headroom = place_key(samples, styles, titles, target, layout, o, logs)
+  -- equal aspect for configuration-space pictures whose frame would still
+  -- fill half the panel (2-D) or whose spans are within a factor 4 (3-D)
+  if o.aspect == nil and lg == "" and all_positions(p) then
+    if dims == 2 then
+      local xs, ys = rng[1][2] - rng[1][1], rng[2][2] - rng[2][1]
+      if xs > 0 and ys > 0 then
+        local r = ys / xs
+        local fw, fh = pw, ph
+        if ph / pw > r then fh = pw * r else fw = ph / r end
+        if fw * fh >= 0.5 * pw * ph then auto.aspect = "equal" end
+      end
+    else
+      local smin, smax = math.huge, 0
+      for j = 1, 3 do
+        local sp = hi[j] - lo[j]
+        smin, smax = math.min(smin, sp), math.max(smax, sp)
+      end
+      if smin > 0 and smax / smin <= 4 then auto.aspect = "equal" end
+    end
   end
-  -- equal units on three axes: the same tic step on all of them (a short
-  -- axis would otherwise crowd its labels)
-  if dims == 3 and #samples > 0 then
-    -- the horizontal axes of a 3-D view are about half the panel wide
-    local lo, hi = bounds(samples, 3)
-    local pw, _, cw = panel_area(target, layout)
+  local aspect = o.aspect
+  if aspect == nil then aspect = auto.aspect end
+  -- the frame gnuplot will draw (2-D)
+  local fw, fh = pw, ph
+  if dims == 2 then
+    local r
+    if aspect == "equal" and rng[1][2] > rng[1][1] and rng[2][2] > rng[2][1] then
+      r = (rng[2][2] - rng[2][1]) / (rng[1][2] - rng[1][1])
+    elseif type(aspect) == "number" and aspect > 0 then
+      r = aspect                               -- "set size ratio r": height / width
+    end
+    if r then
+      if ph / pw > r then fh = pw * r else fw = ph / r end
+    end
+  end
+  if o.key == nil and dims == 2 and #titles > 0 then
+    local kw, kh = key_size(titles, fw, fh, cw, lh)
+    auto.key, auto.headroom = place_key(samples, styles, kw, kh, rng[1], rng[2], o)
+  end
+  local function xlabel_size(chars) return chars * (cw - 1) + 1.5 * cw end
+  if dims == 3 then
+    -- the horizontal axes of a 3-D view are about half the panel wide; with
+    -- equal units every axis gets the same tic step
     local steps, big = {}, 0
-    for j, r in ipairs{"xrange", "yrange", "zrange"} do
-      local a, b, st = drawn_range(lo[j], hi[j], o[r], logs[j])
-      steps[j] = st or 0
+    for j = 1, 3 do
+      steps[j] = step[j] or 0
       if j < 3 and not logs[j] then
-        local thin = thin_tics(a, b, st, 0.5 * pw, function(chars) return chars * (cw - 1) + 1.5 * cw end)
+        local thin = thin_tics(rng[j][1], rng[j][2], step[j], 0.5 * pw, xlabel_size)
         if thin then steps[j], auto[({"xtics", "ytics"})[j]] = thin, thin end
       end
       big = math.max(big, steps[j])
     end
-    if (o.aspect == nil and auto.aspect or o.aspect) == "equal" then
+    if aspect == "equal" then
       for j, a in ipairs{"xtics", "ytics", "ztics"} do
         if big > 0 and steps[j] > 0 and steps[j] < big and not logs[j] then auto[a] = big end
       end
     end
-  end
-  -- tic labels that would run into each other on a narrow panel: fewer
-  -- labels, the range kept as gnuplot would have drawn it
-  if dims == 2 and #samples > 0 then
-    local lo, hi = bounds(samples, 2)
-    local xa, xb, xs = drawn_range(lo[1], hi[1], o.xrange, logs[1])
-    local ya, yb, ys = drawn_range(lo[2], hi[2], o.yrange, logs[2])
-    local ca, cb, da, db = xa, xb, ya, yb
-    local pw, ph, cw, lh = panel_area(target, layout)
-    local aspect = o.aspect == nil and auto.aspect or o.aspect
-    if aspect == "equal" and xb > xa and yb > ya then
-      -- gnuplot widens the shorter range to fill the frame: count the tics
-      -- of both axes over the longer span, in a square of the shorter side
-      local span = math.max(xb - xa, yb - ya)
-      local xc, yc = (xa + xb) / 2, (ya + yb) / 2
-      ca, cb, da, db = xc - span / 2, xc + span / 2, yc - span / 2, yc + span / 2
-      pw = math.min(pw, ph)
-      ph = pw
-    end
+  else
+    -- tic labels that would run into each other in the frame: fewer labels,
+    -- the range kept as gnuplot would have drawn it
     if not logs[1] then
-      auto.xtics = thin_tics(ca, cb, xs, pw, function(chars) return chars * (cw - 1) + 1.5 * cw end)
-      if auto.xtics and o.xrange == nil then auto.xrange = {xa, xb} end
+      auto.xtics = thin_tics(rng[1][1], rng[1][2], step[1], fw, xlabel_size)
+      if auto.xtics and o.xrange == nil then auto.xrange = rng[1] end
     end
     if not logs[2] then
-      auto.ytics = thin_tics(da, db, ys, ph, function() return lh + lh / 4 end)
-      if auto.ytics and o.yrange == nil then auto.yrange = {ya, yb} end
+      auto.ytics = thin_tics(rng[2][1], rng[2][2], step[2], fh, function() return lh + lh / 4 end)
+      if auto.ytics and o.yrange == nil then auto.yrange = rng[2] end
     end
   end
   return auto
