@@ -80,7 +80,11 @@ end
 
 -- The entries whose names start with one of the prefixes, under a heading.
 local function show_group(docs, prefix, heading)
-  local names = sorted_names(docs, function(name) return name:sub(1, #prefix) == prefix end)
+  -- internal entries (dm._gp.send) only when asked for by their prefix
+  local internal = prefix:find("[:.]_") ~= nil
+  local names = sorted_names(docs, function(name)
+    return name:sub(1, #prefix) == prefix and (internal or not name:find("[:.]_"))
+  end)
   if #names > 0 and heading then out(heading, "\n") end
   local w = width()
   for _, name in ipairs(names) do show_entry(docs[name], w) end

@@ -311,7 +311,7 @@ int main(void)
     EXPECT(&s, mark, "true", "the completed column reads");
     mark = s.len;
     send(&s, "dm.plot{ {tr, \"x\", \"p_\t\t");
-    EXPECT(&s, mark, "p_y", "column names of a plot spec listed");
+    EXPECT(&s, mark, "p_y", "column names of a plot series listed");
     mark = s.len;
     send(&s, "\x03");
     EXPECT(&s, mark, "dm> ", "Ctrl-C clears the plot line");

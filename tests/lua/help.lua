@@ -70,6 +70,8 @@ T.ok(at_width(200, dm.help, "dm.integrater"):find("did you mean \"dm.integrator\
 T.ok(at_width(200, dm.help, "routhain"):find("did you mean", 1, true), "help of a misspelt member suggests")
 T.ok(at_width(200, dm.help):find("dm.traceback()", 1, true), "the overview mentions dm.traceback()")
 T.ok(not at_width(200, dm.help):find("_gp", 1, true), "the overview hides internal names")
+T.ok(not at_width(200, dm.help, "dm"):find("_gp", 1, true), "help \"dm\" hides internal names")
+T.ok(at_width(200, dm.help, "dm._gp"):find("dm._gp.send", 1, true), "help \"dm._gp\" shows them")
 local docs = dm.docs()
 T.ok(docs["dm.system"].opts and docs["dm.routh"].opts and docs["integrator:run"].opts,
      "options documented for dm.system, dm.routh, integrator:run")
