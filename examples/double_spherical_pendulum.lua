@@ -75,8 +75,7 @@ local red = dm.routh(dsp, {cyclic = {"theta"}})
 print(red)
 print("  locked inertia I =", red.I)
 print("  connection A =", red.A)
-local st, mu = red:project{q = q0, v = v0}
-red:set{mu = mu}
+local st, mu = red:project{q = q0, v = v0}       -- the reduction takes the state's mu
 do
   local ev = red:eval{q = st.q}
   print(("  mu = J(q0, v0) = %.15g; at x0: I = %.15g, beta = %.6g dr1^dphi + %.6g dr2^dphi "
@@ -221,7 +220,6 @@ for _, c in ipairs{{"bob1", bob1_polar, "theta1", "never"}, {"bob2", bob2_polar,
   local rc = dm.routh(c[2], {cyclic = {c[3]}, native = c[4]})
   local q, v = chart_state(c[1], qx, vx)
   local s, m = rc:project{q = q, v = v}
-  rc:set{mu = m}
   charts[c[1]] = {red = rc, st = s, theta0 = q[2], mu = m}
 end
 print(charts.bob1.red)
@@ -414,7 +412,6 @@ do
   local rd1, rd2, phd, thd = v0[2], v0[3], v0[4], v0[1]
   local s1, s2 = math.sqrt(P.l1^2 - r1^2), math.sqrt(P.l2^2 - r2^2)
   local stc, muc = rc:project{q = {r1, th, -s1, r2, ph, -s2}, v = {rd1, thd, r1 * rd1 / s1, rd2, phd, r2 * rd2 / s2}}
-  rc:set{mu = muc}
   local cart = dm.systems.double_spherical_pendulum_r3{}
   local lob = {method = "lobatto", stages = 3}
 

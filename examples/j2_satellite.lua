@@ -66,9 +66,8 @@ local function unwrap(prev, x)
 end
 
 local function case(fig, J2, method, stages, h, every)
-  red.system.params.J2 = J2
-  local st, mu = red:project{q = q0, v = v0}
-  red:set{mu = mu}
+  red:set{J2 = J2}
+  local st, mu = red:project{q = q0, v = v0}      -- the reduction takes the state's mu
   local I = dm.integrator(red, {method = method, stages = stages, h = h})
   local steps = math.floor(T / h + 0.5)
   local rt = I:run(st, {steps = steps, every = every})
@@ -121,10 +120,9 @@ case("2.5", 0.05, "midpoint", nil, 0.3, 1)
 
 -- reduced = unreduced: the reconstructed orbit against the unreduced midpoint run
 do
-  red.system.params.J2 = 0.05
-  sat.params.J2 = 0.05
-  local st, mu = red:project{q = q0, v = v0}
-  red:set{mu = mu}
+  red:set{J2 = 0.05}
+  sat:set{J2 = 0.05}
+  local st = red:project{q = q0, v = v0}
   local rt = dm.integrator(red, {method = "midpoint", h = 0.3}):run(st, {steps = 500})
   local full = red:reconstruct(rt, {theta = 0})
   local un = dm.integrator(sat, {method = "midpoint", h = 0.3}):run({q = q0, v = v0}, {steps = 500})

@@ -582,8 +582,10 @@ static const dm_reg routh_funcs[] = {
    "Routh reduction by cyclic coordinates, derived symbolically: locked inertia, mechanical "
    "connection A, amended potential, Routhian, classical Routhian, magnetic 2-form beta; "
    "dm.integrator(red, {method = ...}) runs RSPRK (gauss, midpoint, lobatto, trapezoid, prk), "
-   "the discrete Routh equations (dr, dr:gauss, dr:lobatto) or classical-Routhian SPRK "
-   "(classical[:method]) on the reduced state (x, s = dR/dxdot).  A Lagrangian that is not "
+   "the discrete Routh equations (dr, dr:gauss, dr:lobatto), classical-Routhian SPRK "
+   "(classical[:method]) or the continuous Routh equations (rk4, gsl:<stepper>, as references) on "
+   "the reduced state (x, s = dR/dxdot); red:discrete gives the two-point discrete Routh "
+   "equations, red:project / red:reconstruct go between full and reduced.  A Lagrangian that is not "
    "quadratic in the velocities is reduced numerically: J = mu is solved for thetadot and the "
    "reduced system is the classical Routhian L - mu.thetadot, state (x, p_x)."},
   {NULL, NULL, NULL, NULL}
