@@ -468,6 +468,33 @@ void dm_lua_pushsymvec(lua_State *L, const char *label, size_t n,
   lua_remove(L, -2);                                /* leave the proxy */
 }
 
+void dm_lua_symvec_group(lua_State *L, int idx, const char *name, size_t first,
+                         size_t count, const char *label)
+{
+  idx = lua_absindex(L, idx);
+  push_symvec_data(L, idx);
+  int pdata = lua_gettop(L);
+  lua_createtable(L, (int)count, 0);               /* data */
+  for (size_t i = 0; i < count; i++) {
+    lua_rawgeti(L, pdata, (lua_Integer)(first + i) + 1);
+    lua_rawseti(L, -2, (lua_Integer)i + 1);
+  }
+  lua_newtable(L);                                  /* proxy */
+  luaL_setmetatable(L, SYMVEC_MT);
+  lua_getfield(L, LUA_REGISTRYINDEX, SYMVEC_DATA_KEY);
+  lua_pushvalue(L, -2);
+  lua_pushvalue(L, -4);
+  lua_rawset(L, -3);
+  lua_pop(L, 1);
+  lua_getfield(L, LUA_REGISTRYINDEX, LABELS_KEY);
+  lua_pushvalue(L, -2);
+  lua_pushstring(L, label);
+  lua_rawset(L, -3);
+  lua_pop(L, 1);
+  lua_setfield(L, pdata, name);                     /* parent.name = proxy */
+  lua_pop(L, 2);
+}
+
 /* A format must contain exactly one %s and no other conversion. */
 static const char *checkfmt(lua_State *L, int arg)
 {

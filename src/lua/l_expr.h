@@ -35,6 +35,11 @@ void dm_lua_pushexpr(lua_State *L, dm_expr e);
  * names the vector in error messages ("no element 'thta' in q"). */
 void dm_lua_pushsymvec(lua_State *L, const char *label, size_t n,
                        const char *const *elems, const char *fmt, int kind);
+/* Element `name` of the symbolic vector at idx becomes a symbolic vector of
+ * its elements first .. first+count-1 (0-based; indexed 1..count), labelled
+ * label: q.x[i] for an array of coordinates. */
+void dm_lua_symvec_group(lua_State *L, int idx, const char *name, size_t first,
+                         size_t count, const char *label);
 
 /* 1 if the value at idx is a symbolic vector. */
 int dm_lua_issymvec(lua_State *L, int idx);

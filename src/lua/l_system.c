@@ -30,6 +30,9 @@ static void system_release(dm_lsystem *ls)
   free(ls->constr);
   free(ls->cyclic);
   free(ls->buf);
+  for (size_t g = 0; g < ls->ngroups; g++)
+    free(ls->groups[g].name);
+  free(ls->groups);
   memset(ls, 0, sizeof *ls);
   ls->L = DM_EXPR_NONE;
 }
@@ -175,6 +178,24 @@ void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x)
     dm_lua_fail(L, "parameter", e.status, &e);
 }
 
+/* The array called name, or -1. */
+static long find_group(const dm_lsystem *ls, const char *name)
+{
+  for (size_t g = 0; g < ls->ngroups; g++)
+    if (strcmp(ls->groups[g].name, name) == 0)
+      return (long)g;
+  return -1;
+}
+
+/* The array holding coordinate k, or -1. */
+static long group_of(const dm_lsystem *ls, size_t k)
+{
+  for (size_t g = 0; g < ls->ngroups; g++)
+    if (k >= ls->groups[g].first && k < ls->groups[g].first + ls->groups[g].count)
+      return (long)g;
+  return -1;
+}
+
 void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
                            const char *what, double *out)
 {
@@ -207,18 +228,46 @@ void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
     }
     return;
   }
-  /* keyed by coordinate names */
+  /* keyed by coordinate names, arrays by their names */
   lua_pushnil(L);
   while (lua_next(L, idx) != 0) {
-    if (lua_type(L, -2) != LUA_TSTRING || dm_lua_system_coord(ls, lua_tostring(L, -2)) < 0) {
+    if (lua_type(L, -2) != LUA_TSTRING || (dm_lua_system_coord(ls, lua_tostring(L, -2)) < 0 &&
+                                          find_group(ls, lua_tostring(L, -2)) < 0)) {
       const char *key = luaL_tolstring(L, -2, NULL);
       const char *known = dm_lsystem_names(L, ls->sys.coords, n);
       luaL_error(L, "%s: unknown coordinate %s (coordinates: %s)", what, key, known);
     }
     lua_pop(L, 1);
   }
+  for (size_t g = 0; g < ls->ngroups; g++) {
+    const struct dm_lcoordarray *G = &ls->groups[g];
+    if (lua_getfield(L, idx, G->name) == LUA_TNIL) {
+      lua_pop(L, 1);
+      continue;
+    }
+    if (lua_type(L, -1) != LUA_TTABLE || lua_rawlen(L, -1) != G->count)
+      luaL_error(L, "%s: %s must be a list of %d numbers (the array %s[1..%d])", what, G->name,
+                 (int)G->count, G->name, (int)G->count);
+    for (size_t i = 0; i < G->count; i++) {
+      int isnum;
+      lua_rawgeti(L, -1, (lua_Integer)i + 1);
+      out[G->first + i] = lua_tonumberx(L, -1, &isnum);
+      if (!isnum || lua_type(L, -1) != LUA_TNUMBER)
+        luaL_error(L, "%s: number expected at %s[%d], got %s", what, G->name, (int)i + 1,
+                   luaL_typename(L, -1));
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+  }
   for (k = 0; k < n; k++) {
     int isnum;
+    long g = group_of(ls, k);
+    if (g >= 0) {                     /* given by the array's name? */
+      int given = lua_getfield(L, idx, ls->groups[g].name) != LUA_TNIL;
+      lua_pop(L, 1);
+      if (given)
+        continue;
+    }
     lua_getfield(L, idx, ls->sys.coords[k]);
     out[k] = lua_tonumberx(L, -1, &isnum);
     if (!isnum || lua_type(L, -1) != LUA_TNUMBER)
@@ -246,27 +295,130 @@ static int is_ident(const char *s)
   return 1;
 }
 
-/* coords = {"r", "theta", ...}: pushes a userdata array of names (kept
- * alive by the table at t). */
-static const char **read_coords(lua_State *L, int t, size_t *n)
+#define COORDS_MT "dmech.coords"
+
+/* dm.coords(name, n): an array of n coordinates name[1] .. name[n] for
+ * dm.system's coords (alone or in the list). */
+static int l_coords(lua_State *L)
+{
+  const char *name = luaL_checkstring(L, 1);
+  lua_Integer n = luaL_checkinteger(L, 2);
+  if (!is_ident(name))
+    luaL_argerror(L, 1, "a name (letters, digits, _) expected");
+  luaL_argcheck(L, n >= 1 && n <= 1000000, 2, "1 to 1000000 coordinates expected");
+  lua_createtable(L, 0, 2);
+  lua_pushvalue(L, 1);
+  lua_setfield(L, -2, "name");
+  lua_pushinteger(L, n);
+  lua_setfield(L, -2, "n");
+  luaL_setmetatable(L, COORDS_MT);
+  return 1;
+}
+
+static int coords_tostring(lua_State *L)
+{
+  lua_getfield(L, 1, "name");
+  lua_getfield(L, 1, "n");
+  lua_pushfstring(L, "coords %s[1..%d]", lua_tostring(L, -2), (int)lua_tointeger(L, -1));
+  return 1;
+}
+
+/* A dm.coords object at idx? */
+static int is_coords(lua_State *L, int idx)
+{
+  if (lua_type(L, idx) != LUA_TTABLE || !lua_getmetatable(L, idx))
+    return 0;
+  luaL_getmetatable(L, COORDS_MT);
+  int is = lua_rawequal(L, -1, -2);
+  lua_pop(L, 2);
+  return is;
+}
+
+static int cmp_names(const void *a, const void *b)
+{
+  return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* coords = {"r", "theta", ...} with dm.coords arrays among them (or one
+ * array alone): pushes a userdata array of names (kept alive by the table
+ * at t, and by a table of the names made for arrays, also pushed), and
+ * the arrays into ls->groups. */
+static const char **read_coords(lua_State *L, int t, dm_lsystem *ls, size_t *n)
 {
   const char **names;
-  if (lua_getfield(L, t, "coords") != LUA_TTABLE || (*n = lua_rawlen(L, -1)) == 0)
-    luaL_error(L, "dm.system: field 'coords' must be a non-empty list of coordinate names, got %s",
-               luaL_typename(L, -1));
-  int c = lua_gettop(L);
-  names = lua_newuserdatauv(L, *n * sizeof *names, 0);
-  for (size_t i = 0; i < *n; i++) {
-    if (lua_rawgeti(L, c, (lua_Integer)i + 1) != LUA_TSTRING || !is_ident(lua_tostring(L, -1)))
-      luaL_error(L, "dm.system: coordinate %d must be a name (letters, digits, _), got %s",
-                 (int)i + 1, luaL_tolstring(L, -1, NULL));
-    names[i] = lua_tostring(L, -1);
-    lua_pop(L, 1);
-    for (size_t j = 0; j < i; j++)
-      if (strcmp(names[j], names[i]) == 0)
-        luaL_error(L, "dm.system: coordinate '%s' is listed twice", names[i]);
+  int type = lua_getfield(L, t, "coords"), c = lua_gettop(L);
+  if (is_coords(L, c)) {                    /* dm.coords alone: a list of it */
+    lua_createtable(L, 1, 0);
+    lua_pushvalue(L, c);
+    lua_rawseti(L, -2, 1);
+    lua_replace(L, c);
   }
-  return names;
+  size_t len = type == LUA_TTABLE ? lua_rawlen(L, c) : 0;
+  if (len == 0)
+    luaL_error(L, "dm.system: field 'coords' must be a non-empty list of coordinate names "
+               "(or arrays: dm.coords(name, n)), got %s", luaL_typename(L, c));
+  /* count, and the arrays */
+  *n = 0;
+  for (size_t i = 0; i < len; i++) {
+    lua_rawgeti(L, c, (lua_Integer)i + 1);
+    if (is_coords(L, -1)) {
+      lua_getfield(L, -1, "n");
+      *n += (size_t)lua_tointeger(L, -1);
+      lua_pop(L, 1);
+      ls->ngroups++;
+    } else {
+      *n += 1;
+    }
+    lua_pop(L, 1);
+  }
+  if (ls->ngroups > 0 && (ls->groups = calloc(ls->ngroups, sizeof *ls->groups)) == NULL)
+    luaL_error(L, "out of memory");
+  names = lua_newuserdatauv(L, *n * sizeof *names, 0);
+  lua_createtable(L, 0, 0);                     /* anchors the made names */
+  int anchor = lua_gettop(L);
+  size_t k = 0, g = 0;
+  for (size_t i = 0; i < len; i++) {
+    lua_rawgeti(L, c, (lua_Integer)i + 1);
+    if (is_coords(L, -1)) {
+      lua_getfield(L, -1, "name");
+      lua_getfield(L, -2, "n");
+      const char *an = lua_tostring(L, -2);
+      size_t cnt = (size_t)lua_tointeger(L, -1);
+      if ((ls->groups[g].name = strdup(an)) == NULL)
+        luaL_error(L, "out of memory");
+      ls->groups[g].first = k;
+      ls->groups[g++].count = cnt;
+      for (size_t j = 0; j < cnt; j++) {
+        lua_pushfstring(L, "%s[%d]", an, (int)j + 1);
+        names[k++] = lua_tostring(L, -1);
+        lua_rawseti(L, anchor, (lua_Integer)k);
+      }
+      lua_pop(L, 3);
+      continue;
+    }
+    if (lua_type(L, -1) != LUA_TSTRING || !is_ident(lua_tostring(L, -1)))
+      luaL_error(L, "dm.system: coordinate %d must be a name (letters, digits, _) or "
+                 "dm.coords(name, n), got %s", (int)i + 1, luaL_tolstring(L, -1, NULL));
+    names[k++] = lua_tostring(L, -1);
+    lua_pop(L, 1);
+  }
+  /* names used twice (also an array's name as a coordinate): sorted */
+  const char **sorted = malloc((*n + ls->ngroups + 1) * sizeof *sorted);
+  if (sorted == NULL)
+    luaL_error(L, "out of memory");
+  memcpy(sorted, names, *n * sizeof *sorted);
+  for (g = 0; g < ls->ngroups; g++)
+    sorted[*n + g] = ls->groups[g].name;
+  qsort(sorted, *n + ls->ngroups, sizeof *sorted, cmp_names);
+  for (size_t i = 1; i < *n + ls->ngroups; i++)
+    if (strcmp(sorted[i - 1], sorted[i]) == 0) {
+      char dup[300];
+      snprintf(dup, sizeof dup, "%s", sorted[i]);
+      free(sorted);
+      luaL_error(L, "dm.system: coordinate '%s' is listed twice", dup);
+    }
+  free(sorted);
+  return names;             /* the anchor table stays on the stack */
 }
 
 static int cmp_str(const void *a, const void *b)
@@ -468,7 +620,7 @@ static int l_system(lua_State *L)
   check_fields(L, 1);
   const char *name = dm_optstringfield(L, 1, "name", "system");
   dm_lsystem *ls = dm_lua_system_new(L);             /* 2 */
-  coords = read_coords(L, 1, &n);
+  coords = read_coords(L, 1, ls, &n);
   npar = read_params(L, 1, &pnames, &pvals);
   int mode = native_mode(L, 1);
   lua_getfield(L, 1, "L");
@@ -480,6 +632,14 @@ static int l_system(lua_State *L)
   args[0] = lua_gettop(L);
   dm_lua_pushsymvec(L, "v", n, coords, "v_%s", DM_EXPR_SYM);
   args[1] = lua_gettop(L);
+  for (size_t g = 0; g < ls->ngroups; g++) {        /* q.x[i], v.x[i] */
+    const struct dm_lcoordarray *G = &ls->groups[g];
+    lua_pushfstring(L, "q.%s", G->name);
+    dm_lua_symvec_group(L, args[0], G->name, G->first, G->count, lua_tostring(L, -1));
+    lua_pushfstring(L, "v.%s", G->name);
+    dm_lua_symvec_group(L, args[1], G->name, G->first, G->count, lua_tostring(L, -1));
+    lua_pop(L, 2);
+  }
   dm_lua_pushsymvec(L, "p", npar, pnames, NULL, DM_EXPR_PARAM);
   args[2] = lua_gettop(L);
 
@@ -585,7 +745,13 @@ static const dm_reg system_funcs[] = {
    "\"auto\" runs at once on the tape while native code compiles in the background and "
    "takes over between steps (sys.compiling, sys.native, sys.native_error); \"wait\" "
    "compiles first (Ctrl-C: the tape); \"always\" compiles first and fails without a "
-   "compiler; \"never\" keeps the tape."},
+   "compiler; \"never\" keeps the tape.  coords may hold arrays dm.coords(name, n): "
+   "coordinates name[1] .. name[n], q.name[i] in L."},
+  {"coords", l_coords, "dm.coords(name, n) -> coordinate array",
+   "An array of n coordinates name[1] .. name[n] for dm.system's coords, alone or in the "
+   "list with names and other arrays (coords = {\"theta\", dm.coords(\"x\", 64)}): in L, "
+   "q.name[i] and v.name[i] (#q.name = n); states may give it as {name = {...}}; "
+   "trajectories name its columns name[i] (traj.q.name[i])."},
   {NULL, NULL, NULL, NULL}
 };
 
@@ -595,6 +761,11 @@ static const char *const system_keys[] = {"name", "coords", "params", "L", "forc
 void dm_open_system(lua_State *L)
 {
   dm_lsystem_open_class(L);
+  if (luaL_newmetatable(L, COORDS_MT)) {
+    lua_pushcfunction(L, coords_tostring);
+    lua_setfield(L, -2, "__tostring");
+  }
+  lua_pop(L, 1);
   dm_register(L, "dm.", system_funcs);
   dm_doc_options(L, "dm.system", system_keys);
 }

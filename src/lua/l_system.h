@@ -47,6 +47,13 @@ typedef struct dm_lsystem {
   dm_expr *force;       /* n generalized-force components, or NULL */
   dm_expr *constr;      /* m constraint expressions g(q) (0 = satisfied), or NULL */
   unsigned char *cyclic;  /* n flags: L, force, constraints free of q_i */
+  /* coordinate arrays (dm.coords): coordinates first .. first+count-1 are
+   * name[1] .. name[count] */
+  size_t ngroups;
+  struct dm_lcoordarray {
+    char *name;
+    size_t first, count;
+  } *groups;
   /* private to l_system.c: conversions (Legendre maps) and scratch */
   dm_integrator *conv;
   double *buf;          /* 6n doubles */
@@ -72,6 +79,7 @@ void dm_lsystem_checkfinite(lua_State *L, const char *what, const char *name, do
 
 /* Read n numbers for the system's coordinates from the value at idx: a vec,
  * a list of numbers, or a table keyed by coordinate names ({r = 2, z = 0.3};
+ * an array of coordinates by its name and a list, {x = {...}, theta = 1};
  * missing names raise).  `what` names the value in messages ("state.q").
  * Raises on a wrong type or length; writes out[0..n). */
 void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,

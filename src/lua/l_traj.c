@@ -19,6 +19,7 @@
 #include "core/trajectory_h5.h"
 
 #define COLS_MT "dmech.trajectory.columns"
+#define ARR_MT "dmech.trajectory.array"
 
 typedef struct ltraj {
   dm_traj *tr;
@@ -159,6 +160,80 @@ static void push_columns_proxy(lua_State *L, int tidx, const dm_traj *tr, char k
   luaL_setmetatable(L, COLS_MT);
 }
 
+/* traj.q.x for an array of coordinates x[1] .. x[k] (dm.coords): a proxy
+ * whose [i] is the column of x[i] (of the kind: q, p or v).  Pushes it and
+ * returns 1, or 0 when there is no such array.  The trajectory (at the top
+ * of the stack) is its user value. */
+typedef struct arrproxy {
+  char kind;
+  size_t first, count;
+} arrproxy;
+
+static int push_array_proxy(lua_State *L, const dm_traj *tr, char kind, const char *name)
+{
+  size_t n = dm_traj_ncoords(tr), ln = strlen(name), first = n, count = 0;
+  char want[DM_TRAJ_NAME_MAX + 32];
+  for (size_t i = 0; i < n; i++) {
+    const char *c = dm_traj_coord(tr, i);
+    if (strncmp(c, name, ln) == 0 && c[ln] == '[') {
+      snprintf(want, sizeof want, "%s[%zu]", name, count + 1);
+      if (strcmp(c, want) != 0 || (count > 0 && i != first + count))
+        break;                    /* not the array's next element */
+      if (count == 0)
+        first = i;
+      count++;
+    } else if (count > 0) {
+      break;
+    }
+  }
+  if (count == 0)
+    return 0;
+  int t = lua_gettop(L);
+  arrproxy *u = lua_newuserdatauv(L, sizeof *u, 2);
+  u->kind = kind;
+  u->first = first;
+  u->count = count;
+  lua_pushvalue(L, t);
+  lua_setiuservalue(L, -2, 1);
+  lua_pushstring(L, name);
+  lua_setiuservalue(L, -2, 2);
+  luaL_setmetatable(L, ARR_MT);
+  return 1;
+}
+
+static int arr_index(lua_State *L)
+{
+  arrproxy *u = luaL_checkudata(L, 1, ARR_MT);
+  lua_Integer k = luaL_checkinteger(L, 2);
+  lua_getiuservalue(L, 1, 1);
+  dm_traj *tr = open_traj(L, -1);
+  if (k < 1 || (lua_Unsigned)k > u->count) {
+    lua_getiuservalue(L, 1, 2);
+    return luaL_error(L, "index %d out of range 1..%d for the array %s", (int)k,
+                      (int)u->count, lua_tostring(L, -1));
+  }
+  size_t i = u->first + (size_t)k - 1;
+  size_t j = u->kind == 'q' ? dm_traj_qcol(tr, i) : u->kind == 'p' ? dm_traj_pcol(tr, i)
+                                                                     : dm_traj_vcol(tr, i);
+  push_column(L, tr, j);
+  return 1;
+}
+
+static int arr_len(lua_State *L)
+{
+  lua_pushinteger(L, (lua_Integer)((arrproxy *)luaL_checkudata(L, 1, ARR_MT))->count);
+  return 1;
+}
+
+static int arr_tostring(lua_State *L)
+{
+  arrproxy *u = luaL_checkudata(L, 1, ARR_MT);
+  lua_getiuservalue(L, 1, 2);
+  lua_pushfstring(L, "<%c columns %s[1..%d] of a trajectory>", u->kind, lua_tostring(L, -1),
+                  (int)u->count);
+  return 1;
+}
+
 static int cols_index(lua_State *L)
 {
   char kind = *(char *)luaL_checkudata(L, 1, COLS_MT);
@@ -174,6 +249,8 @@ static int cols_index(lua_State *L)
     const char *name = dm_checkcstring(L, 2);
     for (i = 0; i < n && strcmp(dm_traj_coord(tr, i), name) != 0; i++)
       ;
+    if (i == n && push_array_proxy(L, tr, kind, name))
+      return 1;
   }
   if (i == n) {
     const char *q = lua_type(L, 2) == LUA_TSTRING ? "'" : "";
@@ -688,7 +765,7 @@ static const dm_reg traj_methods[] = {
 
 static const dm_field traj_fields[] = {
   {"t", "traj.t -> vec", "The times of the samples (the same as traj:column(\"t\"))."},
-  {"q", "traj.q -> columns", "The coordinate columns by name or number: traj.q.x, traj.q[1] (vecs)."},
+  {"q", "traj.q -> columns", "The coordinate columns by name or number: traj.q.x, traj.q[1] (vecs); an array of coordinates (dm.coords) by its name and index, traj.q.x[3] (#traj.q.x elements)."},
   {"p", "traj.p -> columns", "The momentum columns by coordinate name or number, when recorded."},
   {"v", "traj.v -> columns", "The velocity columns by coordinate name or number, when recorded."},
   {NULL, NULL, NULL}
@@ -721,6 +798,14 @@ void dm_open_traj(lua_State *L)
   dm_newclass(L, DM_TRAJ_MT, "trajectory", traj_methods, traj_meta);
   lua_pop(L, 1);
   dm_doc_fields(L, "trajectory", traj_fields);
+  luaL_newmetatable(L, ARR_MT);
+  lua_pushcfunction(L, arr_index);
+  lua_setfield(L, -2, "__index");
+  lua_pushcfunction(L, arr_len);
+  lua_setfield(L, -2, "__len");
+  lua_pushcfunction(L, arr_tostring);
+  lua_setfield(L, -2, "__tostring");
+  lua_pop(L, 1);
   luaL_newmetatable(L, COLS_MT);
   luaL_setfuncs(L, cols_meta, 0);
   lua_pushliteral(L, "trajectory columns");
