@@ -516,5 +516,7 @@ int dm_lie_register_integrators(dm_err *e)
   int st = dm_integrator_register(&dm_lie_integ_lgvi, e);
   if (st == DM_OK)
     st = dm_integrator_register(&dm_lie_integ_gauss, e);
+  if (st == DM_OK)
+    st = dm_integrator_register(&dm_lie_integ_gsl, e);
   return st;
 }

@@ -61,6 +61,6 @@ int dm_lie_update_J(dm_lie_system *S, dm_err *e);
 int dm_lie_gauss_program(dm_lie_system *S, size_t s, int cayley, const dm_lie_gauss_prog **out,
                          dm_err *e);
 
-extern const dm_integrator_type dm_lie_integ_lgvi, dm_lie_integ_gauss;
+extern const dm_integrator_type dm_lie_integ_lgvi, dm_lie_integ_gauss, dm_lie_integ_gsl;
 
 #endif

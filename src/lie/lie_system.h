@@ -29,6 +29,9 @@
  *                xi(t) a polynomial of degree s in the exp chart at g_k,
  *                s-point Gauss quadrature (stages = s, default 2), order 2s;
  *                "lie:gauss:cayley" uses the Cayley chart.
+ *   gsl:<stepper> GSL odeiv2 fixed-step Runge-Kutta (rk2, rk4, rkf45, rkck,
+ *                rk8pd) on the Euler-Poincare equations, quaternions for the
+ *                rotations: not structure preserving, a reference.
  * On a reduced system (spec->reduced: the discrete Euler-Poincare
  * equations) the same families step mu from the reduced Lagrangian
  * l(xi) = L(e, xi) alone and reconstruct g.

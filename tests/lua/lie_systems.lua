@@ -159,6 +159,14 @@ T.group("SE3", function()
   end
 end)
 
+T.group("the non-symplectic reference", function()
+  local I = dm.integrator(top, {method = "gsl:rk4", h = 0.01})
+  local tr = I:run(s0, {t = 10})
+  local J3 = tr:momentum("3")
+  T.ok(math.abs(J3[#J3] - J3[1]) > 1e-11, "gsl:rk4 on quaternions does not conserve the vertical momentum: " .. math.abs(J3[#J3] - J3[1]))
+  T.ok(I:symplecticity_defect(s0, 0.3) > 1e-6, "nor the symplectic form")
+end)
+
 T.group("forcing", function()
   local damped = dm.system{space = SO3, params = {c = 0.3},
     L = function(R, Om, p) return 0.5 * (Om[1]^2 + 2 * Om[2]^2 + 3 * Om[3]^2) end,
@@ -187,7 +195,8 @@ T.group("errors", function()
     "run with h < 0")
   T.error_like(function() I:step(s0, 0) end, "step: h must be a finite number > 0", "step h = 0")
   T.error_like(function() dm.integrator(top, {method = "gauss"}) end,
-    "dm%.integrator: .*gauss", "a vector-space method on a group")
+    "dm%.integrator: method 'gauss' does not apply to system 'heavy top' %(a lie system%); it integrates .- systems %(methods here: lgvi, lie:gauss, lie:gauss:cayley, gsl:<stepper>%)",
+    "a vector-space method on a group lists the methods for groups")
   T.error_like(function() dm.integrator(top, {method = "lgvi", stages = 2}) end,
     "dm%.integrator: option 'stages' does not apply to method 'lgvi'", "option for another method")
   T.error_like(function() dm.integrator(top, {method = "lgvi", hh = 2}) end,
