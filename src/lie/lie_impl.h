@@ -159,16 +159,20 @@ static inline double dm_v3_dot(const double *a, const double *b)
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* C = A B (C may alias A or B) */
+/* C = A B (C may alias A or B): every product in a local first */
 static inline void dm_m3_mul(const double *A, const double *B, double *C)
 {
-  double T[9];
-  int i, j;
-  for (i = 0; i < 3; i++)
-    for (j = 0; j < 3; j++)
-      T[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-  for (i = 0; i < 9; i++)
-    C[i] = T[i];
+  double c0 = A[0] * B[0] + A[1] * B[3] + A[2] * B[6];
+  double c1 = A[0] * B[1] + A[1] * B[4] + A[2] * B[7];
+  double c2 = A[0] * B[2] + A[1] * B[5] + A[2] * B[8];
+  double c3 = A[3] * B[0] + A[4] * B[3] + A[5] * B[6];
+  double c4 = A[3] * B[1] + A[4] * B[4] + A[5] * B[7];
+  double c5 = A[3] * B[2] + A[4] * B[5] + A[5] * B[8];
+  double c6 = A[6] * B[0] + A[7] * B[3] + A[8] * B[6];
+  double c7 = A[6] * B[1] + A[7] * B[4] + A[8] * B[7];
+  double c8 = A[6] * B[2] + A[7] * B[5] + A[8] * B[8];
+  C[0] = c0, C[1] = c1, C[2] = c2, C[3] = c3, C[4] = c4, C[5] = c5;
+  C[6] = c6, C[7] = c7, C[8] = c8;
 }
 
 /* C = A^T B */
@@ -181,6 +185,24 @@ static inline void dm_m3_tmul(const double *A, const double *B, double *C)
       T[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
   for (i = 0; i < 9; i++)
     C[i] = T[i];
+}
+
+/* Solve A x = b for a 3x3 A by its adjugate (Cramer): 0, or -1 when
+ * |det A| is not above 1e-300 or not finite.  b is overwritten by x.  Used
+ * on the well-conditioned Jacobians of the rotation equations, where it
+ * costs a third of a pivoting LU. */
+static inline int dm_m3_solve(const double *A, double *b)
+{
+  double c0 = A[4] * A[8] - A[5] * A[7], c1 = A[5] * A[6] - A[3] * A[8];
+  double c2 = A[3] * A[7] - A[4] * A[6];
+  double det = A[0] * c0 + A[1] * c1 + A[2] * c2, x0, x1, x2;
+  if (!(fabs(det) > 1e-300) || !isfinite(det))
+    return -1;
+  x0 = (c0 * b[0] + (A[2] * A[7] - A[1] * A[8]) * b[1] + (A[1] * A[5] - A[2] * A[4]) * b[2]) / det;
+  x1 = (c1 * b[0] + (A[0] * A[8] - A[2] * A[6]) * b[1] + (A[2] * A[3] - A[0] * A[5]) * b[2]) / det;
+  x2 = (c2 * b[0] + (A[1] * A[6] - A[0] * A[7]) * b[1] + (A[0] * A[4] - A[1] * A[3]) * b[2]) / det;
+  b[0] = x0, b[1] = x1, b[2] = x2;
+  return 0;
 }
 
 /* y = A x, y = A^T x (y may alias x) */
@@ -238,14 +260,24 @@ static inline void dm_so3_poly_apply(const double *w, double a, double b, double
   y[2] = a * x[2] + b * wx[2] + c * wwx[2];
 }
 
-/* SO(3) exp (Rodrigues, series near 0): cos(th) I + A hat(w) + B w w^T,
- * the diagonal base cos(th) computed directly away from 0 (1 - B t would
- * round cos(pi/2) to 1.1e-16) */
+/* SO(3) exp (Rodrigues): cos(th) I + A hat(w) + B w w^T with A = sin th/th,
+ * B = (1 - cos th)/th^2; one sine and cosine of th (the compiler pairs them),
+ * 1 - cos th = sin^2 th/(1 + cos th) while cos th > 0 (no cancellation);
+ * the series below t = 1e-2. */
 static inline void dm_so3_exp(const double *w, double *R)
 {
-  double t = dm_v3_dot(w, w), B = dm_lie_cosc(t);
-  double d = t < 1e-2 ? 1.0 - B * t : cos(sqrt(t));
-  dm_so3_poly_d(w, d, dm_lie_sinc(t), B, R, 3);
+  double t = dm_v3_dot(w, w), A, B, d;
+  if (t < 1e-2) {
+    A = dm_lie_horner(dm_lie_ser_sinc, 6, t);
+    B = dm_lie_horner(dm_lie_ser_cosc, 6, t);
+    d = 1.0 - B * t;
+  } else {
+    double th = sqrt(t), s = sin(th), c = cos(th);
+    A = s / th;
+    B = (c > 0.0 ? s * s / (1.0 + c) : 1.0 - c) / t;
+    d = c;
+  }
+  dm_so3_poly_d(w, d, A, B, R, 3);
 }
 
 /* SO(3) Cayley map I + (4/(4 + |w|^2)) (hat(w) + hat(w)^2/2) */

@@ -214,7 +214,6 @@ static int solve_rotation(const lgfac *fc, const double *r, double *f, int maxit
   for (it = 0; it < maxiter; it++) {
     double t = dm_v3_dot(f, f), a = dm_lie_sinc(t), b = dm_lie_cosc(t), da, db;
     double Jf[3], fJf[3], G[3], A[9], Jh[9], fhJ[9], fn;
-    size_t perm[3];
     int i, j;
     dm_m3_apply(fc->J, f, Jf);
     dm_v3_cross(f, Jf, fJf);
@@ -229,10 +228,9 @@ static int solve_rotation(const lgfac *fc, const double *r, double *f, int maxit
       for (j = 0; j < 3; j++)
         A[3 * i + j] = a * fc->J[3 * i + j] + b * (fhJ[3 * i + j] - Jh[3 * i + j]) +
                        (Jf[i] * da + fJf[i] * db) * f[j];
-    if (dm_smalllu_factor(A, 3, perm) != DM_OK)
+    if (dm_m3_solve(A, G) != 0)
       return dm_err_set(e, DM_ESINGULAR, "lgvi: singular Jacobian of the rotation equation "
                         "(|f| = %.6g: the step turns the body by about pi)", sqrt(t));
-    dm_smalllu_solve(A, 3, perm, G);
     for (i = 0; i < 3; i++)
       f[i] -= G[i];
     fn = dm_norm_inf(f, 3);
@@ -288,19 +286,9 @@ static int solve_relative(dm_integrator *I, lgvi *W, double h, dm_err *e)
           r[i] -= c[i];
       }
       if (!W->warm || h != W->hprev) {
-        double s = 1.0;
         memcpy(fc->f, r, sizeof fc->f);
-        {
-          double Jl[9];
-          size_t p3[3];
-          memcpy(Jl, fc->J, sizeof Jl);
-          if (dm_smalllu_factor(Jl, 3, p3) == DM_OK)
-            dm_smalllu_solve(Jl, 3, p3, fc->f);
-          else
-            s = 0.0;
-        }
-        for (i = 0; i < 3; i++)
-          fc->f[i] *= s;
+        if (dm_m3_solve(fc->J, fc->f) != 0)
+          fc->f[0] = fc->f[1] = fc->f[2] = 0.0;
       }
       if ((st = solve_rotation(fc, r, fc->f, I->opt.maxiter, I->opt.tol, e)) != DM_OK)
         return st;
