@@ -31,7 +31,9 @@
 
 static lua_State *globalL = NULL;
 static volatile sig_atomic_t sigint_count = 0;
+static volatile sig_atomic_t script_sigint = 0;   /* Ctrl-C while a script ran */
 static int interactive = 0;
+static int script_interrupted = 0;                /* ... and it stopped the script */
 static const void *keep_target = NULL;   /* the script whose locals are kept */
 static char libdir[4096];                /* "@<dir>/" of dmech's Lua library */
 
@@ -39,13 +41,37 @@ static char libdir[4096];                /* "@<dir>/" of dmech's Lua library */
  * Ctrl-C: first press stops the running code, a second one quits
  * ======================================================================= */
 
-/* Hook set by the signal handler: fires at the next Lua instruction.  If a C
- * loop already consumed the interrupt (it returned its partial result and
- * cleared the flag) there is nothing left to stop. */
+/* Does a Ctrl-C stop the script (the default), or only the run it
+ * interrupts (dm.config.interrupt = "run", as at the prompt)? */
+static int interrupt_stops_script(lua_State *L)
+{
+  int top = lua_gettop(L), stops = 1;
+  if (lua_getglobal(L, "dm") == LUA_TTABLE && lua_getfield(L, -1, "config") == LUA_TTABLE
+      && lua_getfield(L, -1, "interrupt") == LUA_TSTRING)
+    stops = strcmp(lua_tostring(L, -1), "run") != 0;
+  lua_settop(L, top);
+  return stops;
+}
+
+/* Hook set by the signal handler: fires at the next Lua instruction.  At
+ * the prompt: if a C loop already consumed the interrupt (it returned its
+ * partial result and cleared the flag) there is nothing left to stop.  In a
+ * script (no prompt) the script stops, also after a run that kept its
+ * partial result, unless dm.config.interrupt = "run"; the program then
+ * exits with status 130. */
 static void lstop(lua_State *L, lua_Debug *ar)
 {
   (void)ar;
   lua_sethook(L, NULL, 0, 0);
+  if (!interactive && script_sigint && (script_interrupted || interrupt_stops_script(L))) {
+    dm_interrupt_clear();
+    script_interrupted = 1;
+    /* armed again: a pcall in the script that catches this does not keep it
+     * going (a second Ctrl-C still quits at once) */
+    lua_sethook(L, lstop, LUA_MASKCOUNT, 1);
+    luaL_error(L, "interrupted (Ctrl-C): the script stops here; with dm.config.interrupt = "
+               "\"run\" a Ctrl-C ends only the run, which keeps what it computed");
+  }
   if (dm_interrupted()) {
     dm_interrupt_clear();
     luaL_error(L, "interrupted!");
@@ -60,8 +86,14 @@ static void laction(int sig)
     raise(sig);
     return;
   }
+  script_sigint = 1;
   dm_interrupt_raise();
   lua_sethook(globalL, lstop, flag, 1);
+}
+
+int dm_script_interrupted(void)
+{
+  return script_interrupted;
 }
 
 /* }====================================================================== */
@@ -353,6 +385,7 @@ int dm_docall(lua_State *L, int narg, int nres)
   lua_insert(L, base);
   globalL = L;
   sigint_count = 0;
+  script_sigint = 0;
   dm_interrupt_clear();
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = laction;

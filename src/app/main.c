@@ -382,7 +382,10 @@ int main(int argc, char **argv)
   result = lua_toboolean(L, -1);
   dm_report(L, status);
   if (!(result && status == LUA_OK))
-    dm_mpi_fail(EXIT_FAILURE);    /* under mpirun: end every rank, none left waiting */
+    dm_mpi_fail(dm_script_interrupted() ? 130 : EXIT_FAILURE);  /* under mpirun: end every rank */
   lua_close(L);
-  return (result && status == LUA_OK) ? EXIT_SUCCESS : EXIT_FAILURE;
+  if (result && status == LUA_OK)
+    return EXIT_SUCCESS;
+  /* a script stopped by Ctrl-C ends as shells expect of one: 128 + SIGINT */
+  return dm_script_interrupted() ? 130 : EXIT_FAILURE;
 }

@@ -34,6 +34,9 @@ void dm_keep_locals(lua_State *L, int idx);
  * prompt passes it to every chunk, which calls it at its end). */
 int dm_keep_caller_locals(lua_State *L);
 
+/* True when a Ctrl-C stopped a script (not at the prompt): exit 130. */
+int dm_script_interrupted(void);
+
 /* Add dm.traceback() to the `dm` global. */
 void dm_open_errors(lua_State *L);
 

@@ -79,6 +79,20 @@ void dm_pushdocs(lua_State *L);
  * NULL or have an empty message, then the status name is used. */
 int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e);
 
+/* The registry key of the dm table (set when the expression binding opens;
+ * dm.config lives in it). */
+#define DM_LUA_DMTABLE "dmech.expr.dm"
+
+/* A run (integ:run) that ended early with status and msg (the partial
+ * trajectory is on the stack): with the run option strict = true (or
+ * dm.config.strict) raise "run: <msg>"; else, unless warn = false (or
+ * dm.config.warn = false), write "warning: run ended early (<status>):
+ * <msg>" to io.stderr; push "run: <msg>" (the second result) and return 1.
+ * dm_lua_run_check_flags checks both options of the table at opts (0: none)
+ * up front. */
+int dm_lua_run_ended(lua_State *L, int opts, int status, const char *msg);
+void dm_lua_run_check_flags(lua_State *L, int opts);
+
 /* luaL_typeerror-style message with a free-form expectation:
  * "bad argument #arg to 'f' (<expected> expected, got <actual>)". */
 int dm_argexpected(lua_State *L, int arg, const char *expected,

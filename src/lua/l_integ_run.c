@@ -5,7 +5,8 @@
  * end.  This file reads the options, draws the progress line on stderr
  * (between pieces, through dm_run's progress callback) and turns the
  * outcome into Lua values: the trajectory, and for an early end a second
- * value, core's message prefixed with "run: ".  Ctrl-C (DM_EINTR) clears
+ * value, core's message prefixed with "run: " (and a warning on stderr, or
+ * an error with strict = true: dm_lua_run_ended).  Ctrl-C (DM_EINTR) clears
  * the interrupt flag so that the REPL does not raise as well. */
 #include <config.h>
 #include <math.h>
@@ -61,7 +62,7 @@ static void progress_end(progress *pg)
  * ======================================================================= */
 
 static const char *const run_keys[] = {"steps", "t", "every", "progress", "energy", "momentum",
-                                       "h", "chunk", "max_energy_error", NULL};
+                                       "h", "chunk", "max_energy_error", "strict", "warn", NULL};
 
 static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, unsigned char *mom)
 {
@@ -99,7 +100,7 @@ static void check_keys(lua_State *L, int o)
       k++;
     if (key == NULL || *k == NULL)
       luaL_error(L, "run: unknown option %s (options: steps, t, every, progress, energy, "
-                 "momentum, h, chunk, max_energy_error)", luaL_tolstring(L, -2, NULL));
+                 "momentum, h, chunk, max_energy_error, strict, warn)", luaL_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
 }
@@ -158,6 +159,7 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int
   lua_pop(L, 2);
   read_momentum(L, o, li->ls, mom);
   r->momentum = mom;
+  dm_lua_run_check_flags(L, o);
 }
 
 /* }====================================================================== */
@@ -199,6 +201,5 @@ int dm_linteg_run(lua_State *L)
   lua_settop(L, 5);
   if (st == DM_OK)
     return 1;
-  lua_pushfstring(L, "run: %s", e.msg);
-  return 2;
+  return 1 + dm_lua_run_ended(L, 3, st, e.msg);
 }

@@ -166,6 +166,52 @@ static void state_label(char *what, size_t size, const char *fname, const char *
   what[k + b] = '\0';
 }
 
+/* A reduced state made by red:project carries the mu it was projected at
+ * (state.mu: a number, or one per cyclic coordinate); the momentum values
+ * are the last parameters of a reduced system (mu_<theta>).  A run at
+ * another mu would compute, silently, the motion of another state. */
+static void check_state_mu(lua_State *L, const dm_lsystem *ls, int idx, const char *fname)
+{
+  double mu[16];
+  size_t r = 0, a;
+  int t = lua_getfield(L, idx, "mu");
+  if (t == LUA_TNIL) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (t == LUA_TNUMBER) {
+    mu[r++] = lua_tonumber(L, -1);
+  } else if (dm_tovec(L, -1) != NULL || t == LUA_TTABLE) {
+    size_t k = dm_tovec(L, -1) ? dm_tovec(L, -1)->size : lua_rawlen(L, -1);
+    for (a = 1; a <= k && r < 16; a++) {
+      if (lua_geti(L, -1, (lua_Integer)a) != LUA_TNUMBER)
+        luaL_error(L, "%s: state.mu[%d] must be a number", fname, (int)a);
+      mu[r++] = lua_tonumber(L, -1);
+      lua_pop(L, 1);
+    }
+  } else {
+    luaL_error(L, "%s: state.mu must be a number or a list of numbers, got %s", fname,
+               luaL_typename(L, -1));
+  }
+  lua_pop(L, 1);
+  if (r == 0 || r > ls->npar)
+    luaL_error(L, "%s: state.mu has %d values, the reduction has %d momenta at most", fname,
+               (int)r, (int)ls->npar);
+  for (a = 0; a < r; a++) {
+    size_t i = ls->npar - r + a;
+    double cur = ls->sys.par[i];
+    if (mu[a] != cur) {
+      char was[DM_NUM_BUFSIZE], now[DM_NUM_BUFSIZE];
+      dm_num_format(was, sizeof was, mu[a]);
+      dm_num_format(now, sizeof now, cur);
+      luaL_error(L, "%s: the state was projected at %s = %s but the reduction's %s is %s: "
+                 "red:set{mu = %s} runs the projected motion; without state.mu the shape "
+                 "state runs at the current mu", fname, ls->sys.params[i], was,
+                 ls->sys.params[i], now, was);
+    }
+  }
+}
+
 void dm_lua_readstate(lua_State *L, dm_lsystem *ls, dm_integrator *I, int idx,
                       const char *fname, double *buf, dm_lstate *s)
 {
@@ -180,6 +226,8 @@ void dm_lua_readstate(lua_State *L, dm_lsystem *ls, dm_integrator *I, int idx,
   if (lua_type(L, idx) != LUA_TTABLE)
     luaL_error(L, "%s: state {q = ..., p = ...} or {q = ..., v = ...} expected, got %s", fname,
                luaL_typename(L, idx));
+  if (ls->sys.kind != NULL && strcmp(ls->sys.kind, "routh") == 0)
+    check_state_mu(L, ls, idx, fname);
   if (lua_getfield(L, idx, "q") == LUA_TNIL)
     luaL_error(L, "%s: the state has no field 'q' (coordinates)", fname);
   state_label(what, sizeof what, fname, "q");
@@ -537,14 +585,16 @@ static const dm_reg integ_methods[] = {
    "One step from {q=, p=} or {q=, v=} (t optional) to a new state {t, q, p, v}; a Newton "
    "failure returns nil and a message with the residual and tolerance."},
   {"run", dm_linteg_run,
-   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=, max_energy_error=}) -> traj[, message]",
+   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=, max_energy_error=, strict=false, warn=true}) -> traj[, message]",
    "Integrate in C to step `steps` or time t, recording every `every` steps a Trajectory with "
    "t, q, p, v, energy and momentum_<coord> columns (cyclic coordinates by default); Ctrl-C, a "
    "failure (Newton, domain) or a runaway (non-finite state or energy; |E - E0| > "
-   "max_energy_error max(1, |E0|) when given) returns the trajectory so far and a second value, "
-   "a message saying at which step and time it stopped; traj:meta() records method, stages, h, "
-   "order, steps, status and message; progress (default: stdout is a terminal) shows a line on "
-   "stderr for runs over 0.5 s, chunk= fixes its steps per update."},
+   "max_energy_error max(1, |E0|) when given) returns the trajectory so far (tr.status, "
+   "tr.message say how it ended) and a second value, a message saying at which step and time "
+   "it stopped, with a warning on stderr (warn = false or dm.config.warn = false: none); "
+   "strict = true (or dm.config.strict) makes an early end an error; traj:meta() records "
+   "method, stages, h, order, steps, status and message; progress (default: stdout is a "
+   "terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
    "step equations (exact Jacobians)."},

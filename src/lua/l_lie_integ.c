@@ -133,7 +133,7 @@ static double get_h(lua_State *L, dm_llinteg *li, int idx, const char *fname)
 /* I:run(state, {t = | steps =, every =, h =}) -> traj[, message] */
 static int l_run(lua_State *L)
 {
-  static const char *const keys[] = {"t", "steps", "every", "h", NULL};
+  static const char *const keys[] = {"t", "steps", "every", "h", "strict", "warn", NULL};
   dm_llinteg *li = checkinteg(L, 1);
   dm_lstate_lie s;
   dm_lie_run_opts o;
@@ -153,10 +153,11 @@ static int l_run(lua_State *L)
     while (key && *k && strcmp(*k, key) != 0)
       k++;
     if (key == NULL || *k == NULL)
-      return luaL_error(L, "run: unknown option %s (options: t, steps, every, h)",
+      return luaL_error(L, "run: unknown option %s (options: t, steps, every, h, strict, warn)",
                         luaL_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
+  dm_lua_run_check_flags(L, 3);
   dm_lua_lie_readstate(L, li->I, li->S, 2, "run", &s);
   memset(&o, 0, sizeof o);
   o.t0 = s.t;
@@ -180,10 +181,8 @@ static int l_run(lua_State *L)
   st = dm_lie_run(li->I, s.g, s.mu, &o, slot, &e);
   if (*slot == NULL)
     return dm_lua_fail(L, "run", st, &e);
-  if (st != DM_OK) {
-    lua_pushstring(L, e.msg);
-    return 2;
-  }
+  if (st != DM_OK)
+    return 1 + dm_lua_run_ended(L, 3, st, e.msg);
   return 1;
 }
 

@@ -273,6 +273,8 @@ static int m_project(lua_State *L)
   if ((st = dm_routh_velocity(u->red, xx, sx, xd, &e)) != DM_OK)   /* Mtilde: mu-free */
     return dm_lua_fail(L, "project", st, &e);
   push_state(L, with_t, t, xx, sx, xd, s);
+  dm_lrouth_push_numbers(L, mu, r);      /* the state remembers its mu: runs check it */
+  lua_setfield(L, -2, "mu");
   dm_lrouth_push_numbers(L, mu, r);
   dm_lrouth_push_numbers(L, th, r);
   return 3;

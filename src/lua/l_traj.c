@@ -9,6 +9,7 @@
  * re-raised after dm_traj_derive has unwound (no longjmp over C memory).
  */
 #include <config.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -311,6 +312,18 @@ static int t_len(lua_State *L)
   return 1;
 }
 
+/* How the run that made tr ended: "success", "interrupted", "no
+ * convergence", "diverged", ... (its status metadata), nil when no run made
+ * it (built from data, or a file without it). */
+static void push_status(lua_State *L, const dm_traj *tr)
+{
+  double st;
+  if (dm_traj_meta_number(tr, "status", &st) && st == floor(st))
+    lua_pushstring(L, dm_strstatus((int)st));
+  else
+    lua_pushnil(L);
+}
+
 static int t_index(lua_State *L)
 {
   dm_traj *tr;
@@ -326,6 +339,10 @@ static int t_index(lua_State *L)
       push_column(L, tr, 0);
     else if (key[1] == '\0' && (key[0] == 'q' || key[0] == 'p' || key[0] == 'v'))
       push_columns_proxy(L, 1, tr, key[0]);
+    else if (strcmp(key, "status") == 0)
+      push_status(L, tr);
+    else if (strcmp(key, "message") == 0)
+      lua_pushstring(L, dm_traj_meta_get(tr, "message"));   /* nil when none */
     else
       lua_pushnil(L);
     return 1;
@@ -401,6 +418,13 @@ static int t_tostring(lua_State *L)
       luaL_addstring(&b, h);
     }
     luaL_addchar(&b, ')');
+  }
+  {
+    double st;
+    if (dm_traj_meta_number(tr, "status", &st) && st != 0 && st == floor(st)) {
+      luaL_addstring(&b, ", ended early: ");
+      luaL_addstring(&b, dm_strstatus((int)st));
+    }
   }
   luaL_addchar(&b, '>');
   luaL_pushresult(&b);
@@ -768,6 +792,11 @@ static const dm_field traj_fields[] = {
   {"q", "traj.q -> columns", "The coordinate columns by name or number: traj.q.x, traj.q[1] (vecs); an array of coordinates (dm.coords) by its name and index, traj.q.x[3] (#traj.q.x elements)."},
   {"p", "traj.p -> columns", "The momentum columns by coordinate name or number, when recorded."},
   {"v", "traj.v -> columns", "The velocity columns by coordinate name or number, when recorded."},
+  {"status", "traj.status -> string | nil",
+   "How the run that made it ended: \"success\", or why it stopped early (\"interrupted\", "
+   "\"no convergence\", \"diverged\", ...); nil for a trajectory no run made."},
+  {"message", "traj.message -> string | nil",
+   "For a run that ended early, what happened (step, time, residual); else nil."},
   {NULL, NULL, NULL}
 };
 

@@ -112,3 +112,68 @@ const char *dm_optstringfield(lua_State *L, int t, const char *key,
   return s;
 }
 
+
+/* {======================================================================
+ * a run that ended early
+ * ======================================================================= */
+
+/* Boolean field `key` of the options table at opts, else of dm.config,
+ * else def. */
+static int run_flag(lua_State *L, int opts, const char *key, int def)
+{
+  int v = def, t, top = lua_gettop(L);
+  if (opts != 0 && lua_istable(L, opts)) {
+    t = lua_getfield(L, opts, key);
+    if (t != LUA_TNIL && t != LUA_TBOOLEAN)
+      luaL_error(L, "run: option '%s' must be a boolean, got %s", key, luaL_typename(L, -1));
+    if (t == LUA_TBOOLEAN) {
+      v = lua_toboolean(L, -1);
+      lua_settop(L, top);
+      return v;
+    }
+    lua_settop(L, top);
+  }
+  if (lua_getfield(L, LUA_REGISTRYINDEX, DM_LUA_DMTABLE) == LUA_TTABLE
+      && lua_getfield(L, -1, "config") == LUA_TTABLE
+      && lua_getfield(L, -1, key) == LUA_TBOOLEAN)
+    v = lua_toboolean(L, -1);
+  lua_settop(L, top);
+  return v;
+}
+
+void dm_lua_run_check_flags(lua_State *L, int opts)
+{
+  opts = opts != 0 ? lua_absindex(L, opts) : 0;
+  run_flag(L, opts, "strict", 0);
+  run_flag(L, opts, "warn", 1);
+}
+
+int dm_lua_run_ended(lua_State *L, int opts, int status, const char *msg)
+{
+  int top = lua_gettop(L), strict, warn;
+  opts = opts != 0 ? lua_absindex(L, opts) : 0;
+  strict = run_flag(L, opts, "strict", 0);
+  warn = run_flag(L, opts, "warn", 1);
+  if (msg == NULL || *msg == '\0')
+    msg = dm_strstatus(status);
+  if (strict)
+    return luaL_error(L, "run: %s", msg);
+  if (warn) {
+    /* through io.stderr, so that a script that redirects it sees it (not
+     * protected: a pending Ctrl-C that stops the script must get through) */
+    if (lua_getglobal(L, "io") == LUA_TTABLE && lua_getfield(L, -1, "stderr") != LUA_TNIL
+        && lua_getfield(L, -1, "write") == LUA_TFUNCTION) {
+      lua_insert(L, -2);
+      lua_pushfstring(L, "warning: run ended early (%s): %s\n", dm_strstatus(status), msg);
+      lua_call(L, 2, 0);
+    } else {
+      fprintf(stderr, "warning: run ended early (%s): %s\n", dm_strstatus(status), msg);
+      fflush(stderr);
+    }
+    lua_settop(L, top);
+  }
+  lua_pushfstring(L, "run: %s", msg);
+  return 1;
+}
+
+/* }====================================================================== */

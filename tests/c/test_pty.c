@@ -4,7 +4,8 @@
  * history (one entry per multi-line chunk) persisted across two sessions;
  * completion of fields, of names and files inside strings and of option
  * keys, help wrapped to the terminal's width, a bracketed paste run
- * statement by statement, the bare words help and quit. */
+ * statement by statement, the bare words help and quit; the warning of a
+ * run that ended early; a script stopped by Ctrl-C exits with 130. */
 #include <config.h>
 
 #include <errno.h>
@@ -33,6 +34,8 @@ typedef struct session {
 
 static const char *dmech, *tmp;
 
+static const char *script_arg = NULL;    /* start_term: run this script, not the prompt */
+
 /* dmech on a new pty of `cols` columns with TERM=term. */
 static int start_term(session *s, const char *statedir, const char *term, unsigned short cols)
 {
@@ -51,7 +54,10 @@ static int start_term(session *s, const char *statedir, const char *term, unsign
     unsetenv("COLUMNS");
     if (chdir(tmp) != 0)
       _exit(126);
-    execl(dmech, dmech, (char *)NULL);
+    if (script_arg != NULL)
+      execl(dmech, dmech, script_arg, (char *)NULL);
+    else
+      execl(dmech, dmech, (char *)NULL);
     _exit(127);
   }
   return 0;
@@ -373,6 +379,46 @@ int main(void)
     send(&s, "quit\r");
     tap_ok(finish(&s, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0,
            "bare quit leaves with status 0");
+  }
+
+  /* ---- a run that ends early warns on the terminal; Ctrl-C stops a script ---- */
+  if (start(&s, state) != 0)
+    return tap_done();
+  EXPECT(&s, 0, "dm> ", "sixth session prompt");
+  mark = s.len;
+  send(&s, "tr = dm.integrator(dm.systems.kepler(), {h = 0.05}):run({q = {0.4, 0}, p = {0, 2}}, "
+           "{steps = 100, max_energy_error = 1e-14})\r");
+  EXPECT(&s, mark, "warning: run ended early (diverged): the energy error",
+         "a run that ends early warns on stderr");
+  mark = s.len;
+  send(&s, "tr.status\r");
+  EXPECT(&s, mark, "\"diverged\"", "tr.status at the prompt");
+  send(&s, "\x04");
+  finish(&s, &status);
+  {
+    char path[1100];
+    FILE *sf;
+    snprintf(path, sizeof path, "%s/pty-interrupted.lua", tmp);
+    sf = fopen(path, "w");
+    if (sf != NULL) {
+      fputs("local I = dm.integrator(dm.systems.kepler{impl = \"c\"}, {method = \"trapezoid\", h = 0.001})\n"
+            "print(\"running\")\n"
+            "local tr = I:run({q = {0.4, 0}, p = {0, 2}}, {steps = 4000000000, every = 1000000})\n"
+            "print(\"after the run\")\n", sf);
+      fclose(sf);
+    }
+    script_arg = path;
+    if (start(&s, state) != 0)
+      return tap_done();
+    script_arg = NULL;
+    EXPECT(&s, 0, "running", "a script runs on the terminal");
+    usleep(300000);
+    mark = s.len;
+    send(&s, "\x03");
+    EXPECT(&s, mark, "interrupted (Ctrl-C): the script stops here", "Ctrl-C stops the script");
+    tap_ok(finish(&s, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 130,
+           "an interrupted script exits with status 130");
+    tap_ok(strstr(s.buf, "after the run") == NULL, "nothing after the run ran");
   }
 
   /* ---- a second Ctrl-C during the same run quits ---- */

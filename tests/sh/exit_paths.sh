@@ -58,8 +58,8 @@ rm -f "$T/cc1.pid"
 CC="$T/fakecc" "$D" "$T/compile.lua" > "$T/int.out" 2>&1 & pid=$!
 wait_file "$T/cc1.pid"; cc1=$(cat "$T/cc1.pid")
 kill -INT $pid; wait $pid; st=$?
-is "$st" 1 "Ctrl-C during a compile stops the script: exit 1"
-like "$(cat "$T/int.out")" "compile.lua:1: interrupted!" "... with 'interrupted!'"
+is "$st" 130 "Ctrl-C during a compile stops the script (also through its pcall): exit 130"
+like "$(cat "$T/int.out")" "compile.lua:1: interrupted \(Ctrl-C\)" "... with 'interrupted (Ctrl-C)'"
 wait_gone "$cc1"; ok $? "... the compiler's child is killed"
 is "$(count_tmp)" 0 "... no build directory left"
 rm -f "$T/cc1.pid"
