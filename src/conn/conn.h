@@ -360,6 +360,24 @@ int dm_conn_dc_order(dm_conn_dc *D, dm_conn_dc *ref, const double *q, const doub
 int dm_conn_dc_limit(dm_conn_dc *D, const double *q, const double *xdot, const double *xi,
                      double eps, double *out, dm_err *e);
 
+/* {==== phases of sampled shape paths ====================================== */
+
+/* The geometric phase of the shape path sampled by a trajectory T: its
+ * columns cols[0..nx) (NULL: the first nx coordinates), followed from
+ * q0 = (x(0), g0) (trivial bundles; q0's shape must be the first sample).
+ * body: P with g_N = g0 P (the body transport; for a closed path the body
+ * holonomy), spatial: g0 P g0^-1, *gap: the largest coordinate difference
+ * between the first and last samples (0 for a closed loop).  The discrete
+ * version lifts sample to sample with D; the continuous one transports
+ * along the straight segments between samples with options o.  Either
+ * output pointer may be NULL.  DM_EINVAL for fewer than 2 samples or a
+ * column out of range. */
+struct dm_traj;
+int dm_conn_dc_phase(dm_conn_dc *D, const struct dm_traj *T, const size_t *cols,
+                     const double *q0, double *spatial, double *body, double *gap, dm_err *e);
+int dm_conn_phase(dm_conn *C, const struct dm_traj *T, const size_t *cols, const double *q0,
+                  const dm_conn_topts *o, double *spatial, double *body, double *gap, dm_err *e);
+
 /* }==== */
 
 /* {==== the discrete Levi-Civita connection of a triangle mesh ============== */

@@ -13,6 +13,7 @@
 #include "lua/l_conn.h"
 #include "lua/l_expr.h"
 #include "lua/l_system.h"
+#include "core/trajectory.h"
 
 /* {==== helpers ============================================================= */
 
@@ -608,6 +609,54 @@ void dm_lua_trace_lagrangian(lua_State *L, const dm_conn_bundle *B, int fidx, in
   lua_settop(L, top);
 }
 
+const size_t *dm_lua_phase_cols(lua_State *L, int bidx, int tidx, int q0idx, size_t *buf,
+                                double *q0)
+{
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, bidx)->B;
+  struct dm_traj *T = dm_checktraj(L, tidx);
+  const size_t *cols = NULL;
+  size_t k;
+  bidx = lua_absindex(L, bidx);
+  if (!dm_conn_bundle_is_trivial(B))
+    luaL_error(L, "phase: needs a trivial bundle S x G, got the %s bundle", B->type->name);
+  if (dm_traj_ncoords(T) != B->nx) {
+    dm_lsystem *ls;
+    dm_lua_bundle_field(L, bidx, "system");
+    ls = dm_lua_tosystem(L, -1);
+    lua_pop(L, 1);
+    if (ls == NULL)
+      luaL_error(L, "phase: the trajectory has %d coordinates, the shape space %d", 
+                 (int)dm_traj_ncoords(T), (int)B->nx);
+    dm_lua_bundle_field(L, bidx, "acts");
+    {
+      unsigned char acts[256] = {0};
+      size_t ns = 0, i;
+      for (k = 1; k <= (size_t)luaL_len(L, -1); k++) {
+        lua_geti(L, -1, (lua_Integer)k);
+        acts[lua_tointeger(L, -1) - 1] = 1;
+        lua_pop(L, 1);
+      }
+      for (i = 0; i < ls->n && ns < B->nx; i++)
+        if (!acts[i]) {
+          size_t j = dm_traj_find(T, ls->sys.coords[i]);
+          if (j == DM_TRAJ_NONE)
+            luaL_error(L, "phase: the trajectory has no column '%s'", ls->sys.coords[i]);
+          buf[ns++] = j;
+        }
+    }
+    lua_pop(L, 1);
+    cols = buf;
+  }
+  if (q0idx != 0 && !lua_isnoneornil(L, q0idx)) {
+    dm_lua_readpoint(L, bidx, q0idx, "phase: q0", q0);
+  } else {
+    for (k = 0; k < B->nx; k++)
+      q0[k] = dm_traj_col(T, cols ? cols[k] : dm_traj_qcol(T, k))[0];
+    dm_lie_identity(B->G, q0 + B->nx);
+  }
+  return cols;
+}
+
 /* }==== */
 
 /* {==== points ============================================================== */
@@ -738,6 +787,7 @@ static int b_act(lua_State *L)
 {
   const dm_conn_bundle *B = dm_lua_checkbundle(L, 1)->B;
   double q[DM_CONN_NQ_MAX], g[DM_LIE_NQ_MAX], gq[DM_CONN_NQ_MAX];
+  lua_settop(L, 3);
   dm_lua_bundle_field(L, 1, "group");
   dm_lua_readgroupelem(L, -1, 2, "act: g", g);
   dm_lua_readpoint(L, 1, 3, "act: q", q);

@@ -75,6 +75,20 @@ void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o
 /* Raise "<fname>: unknown option 'k' (options: a, b)" for keys not in known. */
 void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known);
 
+/* The columns of a trajectory (at tidx) that sample the shape of the
+ * bundle at bidx: NULL when its coordinates are the shape coordinates,
+ * else the columns of the shape coordinates by name (bundles from a
+ * system) written into buf (nx); raises otherwise.  Then reads q0 from
+ * q0idx (0 or nil: the first sample with the identity) into q0. */
+const size_t *dm_lua_phase_cols(lua_State *L, int bidx, int tidx, int q0idx, size_t *buf,
+                                double *q0);
+/* Push a connection on a new trivial bundle S x G (G the group userdata
+ * at gidx) from the expressions A (dim x nx) in the symbols x, with
+ * parameters par (names pnames, values pv): red:connection(). */
+void dm_lua_push_conn_exprs(lua_State *L, int gidx, const char *name, size_t nx,
+                            const dm_expr *x, const dm_expr *A, size_t npar, const dm_expr *par,
+                            const char *const *pnames, const double *pv);
+
 /* continuous connections (l_conn_cont.c) */
 dm_conn *dm_lua_checkconn(lua_State *L, int idx);
 dm_conn *dm_lua_toconn(lua_State *L, int idx);

@@ -13,6 +13,7 @@
 #include "lua/l_conn.h"
 #include "lua/l_expr.h"
 #include "lua/l_system.h"
+#include "core/trajectory.h"
 
 typedef struct dm_lconn {
   dm_conn *C;                   /* NULL until built */
@@ -351,6 +352,7 @@ static int c_form(lua_State *L)
   dm_lconn *c = checklconn(L, 1);
   double q[DM_CONN_NQ_MAX], xd[DM_CONN_NX_MAX], xi[DM_LIE_DIM_MAX], out[DM_LIE_DIM_MAX];
   dm_err e;
+  lua_settop(L, 4);
   conn_field(L, 1, "bundle");
   dm_lua_readpoint(L, lua_gettop(L), 2, "form: q", q);
   readvec(L, 3, c->nx, "form: xdot", xd);
@@ -537,6 +539,76 @@ static int c_holonomy(lua_State *L)
   return 1;
 }
 
+static int c_phase(lua_State *L)
+{
+  dm_lconn *c = checklconn(L, 1);
+  const dm_conn_bundle *B = conn_bundle(L, 1);
+  double q0[DM_CONN_NQ_MAX], S[DM_LIE_NQ_MAX], P[DM_LIE_NQ_MAX], gap;
+  size_t buf[DM_CONN_NX_MAX];
+  const size_t *cols;
+  dm_conn_topts o;
+  dm_err e;
+  int bidx;
+  lua_settop(L, 4);
+  if (lua_istable(L, 4))
+    dm_lua_conn_checkkeys(L, 4, "phase", topt_keys);
+  dm_lua_readtopts(L, 4, "phase", &o);
+  conn_field(L, 1, "bundle");
+  bidx = lua_gettop(L);
+  cols = dm_lua_phase_cols(L, bidx, 2, 3, buf, q0);
+  if (dm_conn_phase(c->C, dm_checktraj(L, 2), cols, q0, &o, S, P, &gap, &e) != DM_OK)
+    return dm_lua_fail(L, "phase", e.status, &e);
+  dm_lua_bundle_field(L, bidx, "group");
+  dm_lua_pushholonomy(L, lua_gettop(L), S, P, B->G->abelian && B->G->dim == 1 ? P[0] : NAN);
+  lua_pushnumber(L, gap);
+  return 2;
+}
+
+void dm_lua_push_conn_exprs(lua_State *L, int gidx, const char *name, size_t nx,
+                            const dm_expr *x, const dm_expr *A, size_t npar, const dm_expr *par,
+                            const char *const *pnames, const double *pv)
+{
+  dm_lbundle *b;
+  dm_lconn *c;
+  size_t k;
+  int bidx, pidx;
+  dm_err e;
+  gidx = lua_absindex(L, gidx);
+  lua_createtable(L, 0, 4);                           /* dm.bundle{...} arguments */
+  lua_pushinteger(L, (lua_Integer)nx);
+  lua_setfield(L, -2, "shape_dim");
+  lua_pushvalue(L, gidx);
+  lua_setfield(L, -2, "group");
+  lua_pushstring(L, name);
+  lua_setfield(L, -2, "name");
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech.core");
+  lua_call(L, 1, 1);
+  lua_getfield(L, -1, "bundle");
+  lua_remove(L, -2);
+  lua_insert(L, -2);
+  lua_call(L, 1, 1);
+  bidx = lua_gettop(L);
+  b = dm_lua_checkbundle(L, bidx);
+  lua_createtable(L, (int)npar, 0);
+  for (k = 0; k < npar; k++) {
+    lua_createtable(L, 2, 0);
+    lua_pushstring(L, pnames[k]);
+    lua_rawseti(L, -2, 1);
+    lua_pushnumber(L, pv[k]);
+    lua_rawseti(L, -2, 2);
+    lua_rawseti(L, -2, (lua_Integer)k + 1);
+  }
+  pidx = lua_gettop(L);
+  c = newconn(L, bidx, pidx);
+  c->npar = npar;
+  memcpy(c->A, A, b->B->G->dim * nx * sizeof *A);
+  if ((c->C = dm_conn_expr_alloc(dm_lua_exprctx(L), b->B, x, A, npar, par, pv, &e)) == NULL)
+    dm_lua_fail(L, "connection", e.status, &e);
+  lua_replace(L, bidx);
+  lua_settop(L, bidx);
+}
+
 static int c_set_params(lua_State *L)
 {
   dm_lconn *c = checklconn(L, 1);
@@ -647,6 +719,8 @@ static const dm_reg conn_methods[] = {
    "The body transport H of the horizontal lift along a curve (polygon, function s -> x(s) on [0, 1], or a list of them): g(1) = g(0) H."},
   {"holonomy", c_holonomy, "A:holonomy(loop, q0[, {substeps = 8 | tol = t}]) -> hol",
    "The holonomy of a closed curve from q0: a table {spatial, body, angle[, axis]} (Magnus 4 per piece, or adaptive rk8pd with tol)."},
+  {"phase", c_phase, "A:phase(traj[, q0][, {substeps = 8 | tol = t}]) -> hol, gap",
+   "The geometric phase of the shape path sampled by a trajectory (straight segments between samples): the body transport as a holonomy table, and the gap between its ends (0 for a loop)."},
   {"set_params", c_set_params, "A:set_params{name = value, ...} -> A",
    "Change the connection's parameters (no recompilation)."},
   {NULL, NULL, NULL, NULL}

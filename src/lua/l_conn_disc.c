@@ -385,8 +385,10 @@ static int l_discrete_mechanical(lua_State *L)
 
 /* {==== methods ============================================================= */
 
-static int bundle_idx(lua_State *L, int didx)
+/* the bundle pushed above the method's nargs arguments (missing ones nil) */
+static int bundle_idx(lua_State *L, int didx, int nargs)
 {
+  lua_settop(L, nargs);
   dfield(L, didx, "bundle");
   return lua_gettop(L);
 }
@@ -402,7 +404,7 @@ static int push_g(lua_State *L, int bidx, const double *g)
 static int d_call(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], g[DM_LIE_NQ_MAX];
   dm_err e;
   dm_lua_readpoint(L, b, 2, "A_d: q0", q0);
@@ -415,7 +417,7 @@ static int d_call(lua_State *L)
 static int d_at(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double x0[DM_CONN_NX_MAX], x1[DM_CONN_NX_MAX], g[DM_LIE_NQ_MAX];
   dm_err e;
@@ -429,7 +431,7 @@ static int d_at(lua_State *L)
 static int hor_ver(lua_State *L, int ver)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], r[DM_CONN_NQ_MAX];
   dm_err e;
   int st;
@@ -456,7 +458,7 @@ static int d_ver(lua_State *L)
 static int d_hlift(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], x1[DM_CONN_NX_MAX], q1[DM_CONN_NQ_MAX];
   dm_err e;
@@ -471,7 +473,7 @@ static int d_hlift(lua_State *L)
 static int d_lift(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], *xs;
   gsl_vector *qs;
@@ -495,7 +497,7 @@ static int d_lift(lua_State *L)
 static int d_holonomy(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], *xs, S[DM_LIE_NQ_MAX], P[DM_LIE_NQ_MAX], lifted;
   int have_body;
@@ -529,7 +531,7 @@ static void read_pair(lua_State *L, int b, int idx, const char *what, double *a0
 static int d_compose(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   double a0[DM_CONN_NQ_MAX], a1[DM_CONN_NQ_MAX], b0[DM_CONN_NQ_MAX], b1[DM_CONN_NQ_MAX],
          c1[DM_CONN_NQ_MAX];
   dm_err e;
@@ -548,7 +550,7 @@ static int d_compose(lua_State *L)
 static int d_reduce(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], x0[DM_CONN_NX_MAX], x1[DM_CONN_NX_MAX],
          z[DM_LIE_NQ_MAX];
@@ -566,7 +568,7 @@ static int d_reduce(lua_State *L)
 static int d_unreduce(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 5);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], x0[DM_CONN_NX_MAX], x1[DM_CONN_NX_MAX],
          z[DM_LIE_NQ_MAX];
@@ -585,7 +587,7 @@ static int d_unreduce(lua_State *L)
 static int d_split(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], x[DM_CONN_NX_MAX], g[DM_LIE_NQ_MAX];
   dm_err e;
@@ -604,7 +606,7 @@ static int d_split(lua_State *L)
 static int d_limit(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 5);
   const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q[DM_CONN_NQ_MAX], xd[DM_CONN_NX_MAX], xi[DM_LIE_DIM_MAX], out[DM_LIE_DIM_MAX],
          eps = luaL_optnumber(L, 5, 1e-4);
@@ -628,10 +630,27 @@ static int d_limit(lua_State *L)
   return 1;
 }
 
+static int d_phase(lua_State *L)
+{
+  dm_ldconn *d = checkld(L, 1);
+  int b = bundle_idx(L, 1, 3);
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
+  double q0[DM_CONN_NQ_MAX], S[DM_LIE_NQ_MAX], P[DM_LIE_NQ_MAX], gap;
+  size_t buf[DM_CONN_NX_MAX];
+  const size_t *cols = dm_lua_phase_cols(L, b, 2, 3, buf, q0);
+  dm_err e;
+  if (dm_conn_dc_phase(d->D, dm_checktraj(L, 2), cols, q0, S, P, &gap, &e) != DM_OK)
+    return dm_lua_fail(L, "phase", e.status, &e);
+  dm_lua_bundle_field(L, b, "group");
+  dm_lua_pushholonomy(L, lua_gettop(L), S, P, B->G->abelian && B->G->dim == 1 ? P[0] : NAN);
+  lua_pushnumber(L, gap);
+  return 2;
+}
+
 static int d_momentum(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1);
+  int b = bundle_idx(L, 1, 3);
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], J[DM_LIE_DIM_MAX];
   dm_err e;
   dm_lua_readpoint(L, b, 2, "momentum: q0", q0);
@@ -724,7 +743,7 @@ static int l_order_test(lua_State *L)
   luaL_checktype(L, 2, LUA_TTABLE);
   lua_settop(L, 2);
   dm_lua_conn_checkkeys(L, 2, "dm.order_test", order_keys);
-  b = bundle_idx(L, 1);                               /* 3 */
+  b = bundle_idx(L, 1, 2);                               /* 3 */
   B = dm_lua_checkbundle(L, b)->B;
   lua_getfield(L, 2, "q");
   dm_lua_readpoint(L, b, -1, "dm.order_test: q", q);
@@ -786,6 +805,8 @@ static const dm_reg dconn_methods[] = {
    "A pair as shape motion and relative group element A_d (the decomposition of geometric control)."},
   {"limit", d_limit, "Ad:limit(q, xdot, xi[, eps = 1e-4]) -> vec",
    "The continuous limit d/de A_d(q, q(e)) at e = 0 by central differences, q(e) = (x + e xdot, g exp(e xi))."},
+  {"phase", d_phase, "Ad:phase(traj[, q0]) -> hol, gap",
+   "The geometric phase of the shape path sampled by a trajectory, lifted sample to sample: the body transport as a holonomy table, and the gap between its ends (0 for a loop)."},
   {"momentum", d_momentum, "Dm:momentum(q0, q1) -> vec",
    "The discrete momentum J_d(q0, q1) = D2 Ld(q0, q1) . xi_Q(q1) of a discrete mechanical connection."},
   {"set_mu", d_set_mu, "Dm:set_mu(mu) -> Dm",

@@ -9,6 +9,8 @@
 #include <string.h>
 
 #include "lua/l_reduce.h"
+#include "lua/l_conn.h"
+#include "lua/l_expr.h"
 
 
 /* scratch doubles owned by a new userdata (pushed) */
@@ -359,13 +361,59 @@ static int m_phase(lua_State *L)
   size_t r = dm_routh_exprs_get(u->red)->r;
   double dyn[DM_ROUTH_RMAX], geo[DM_ROUTH_RMAX], gap;
   dm_err e;
-  int st = dm_routh_phase(u->red, loop, dyn, geo, &gap, &e);
+  int st;
+  if (!lua_isnoneornil(L, 3)) {
+    /* the geometric part through a connection object (any group,
+     * non-abelian included): its phase method on the same loop */
+    if (dm_lua_toconn(L, 3) == NULL && dm_lua_todconn(L, 3) == NULL)
+      return dm_argexpected(L, 3, "connection (continuous or discrete)", luaL_typename(L, 3));
+    lua_settop(L, 3);
+    lua_getfield(L, 3, "phase");
+    lua_pushvalue(L, 3);
+    lua_pushvalue(L, 2);
+    lua_call(L, 2, 2);                        /* 4: hol, 5: gap */
+    if (!dm_routh_is_mechanical(u->red)) {
+      lua_pushnil(L);
+      lua_insert(L, 4);
+      return 3;
+    }
+  }
+  st = dm_routh_phase(u->red, loop, dyn, geo, &gap, &e);
   if (st != DM_OK)
     return dm_lua_fail(L, "phase", st, &e);
   dm_lrouth_push_numbers(L, dyn, r);
+  if (lua_gettop(L) >= 6) {
+    lua_insert(L, 4);                         /* dyn, hol, gap */
+    return 3;
+  }
   dm_lrouth_push_numbers(L, geo, r);
   lua_pushnumber(L, gap);
   return 3;
+}
+
+/* red:connection(): the mechanical connection A = I^-1 M_theta,x as a
+ * connection object on shape x T^r (SO(2) for one cyclic coordinate) */
+static int m_connection(lua_State *L)
+{
+  dm_lrouth *u = dm_lrouth_check(L, 1);
+  const dm_routh_exprs *x = dm_routh_exprs_get(u->red);
+  const dm_system *sys = dm_routh_system(u->red);
+  dm_expr par[64];
+  dm_lie_group **slot;
+  size_t k;
+  dm_err e;
+  if (!dm_routh_is_mechanical(u->red))
+    return luaL_error(L, "connection: L is not mechanical, there is no mechanical connection");
+  if (x->npar > 64)
+    return luaL_error(L, "connection: at most 64 parameters");
+  for (k = 0; k < x->npar; k++)
+    par[k] = dm_expr_param(dm_lua_exprctx(L), sys->params[k]);
+  slot = dm_lua_newgroup(L);
+  if ((*slot = x->r == 1 ? dm_lie_so2(&e) : dm_lie_torus(x->r, &e)) == NULL)
+    return dm_lua_fail(L, "connection", e.status, &e);
+  dm_lua_push_conn_exprs(L, -1, sys->name, x->s, x->x, x->A, x->npar, par, sys->params,
+                         sys->par);
+  return 1;
 }
 
 static void push_mat(lua_State *L, const double *a, size_t rows, size_t cols)
@@ -487,9 +535,12 @@ const dm_reg dm_lrouth_methods[] = {
    "The full trajectory over a reduced one: theta advanced by the reduced integrator's group "
    "increments between samples (Hamiltonian side for RSPRK, psi_mu for dr and classical); method, "
    "stages and h default to the run that made traj."},
-  {"phase", m_phase, "red:phase(loop) -> dynamic, geometric, gap",
+  {"connection", m_connection, "red:connection() -> A",
+   "The mechanical connection of the reduction as a connection object (dm.connection) on shape x SO(2) or T^r, for discrete rules, curvature and holonomy."},
+  {"phase", m_phase, "red:phase(loop[, connection]) -> dynamic, geometric, gap",
    "Split the group advance over a (closed) shape loop into the dynamic part sum dt I^-1 mu and the "
-   "geometric part -sum A(xbar) dx (midpoint rule); gap is the loop's closure defect."},
+   "geometric part -sum A(xbar) dx (midpoint rule); gap is the loop's closure defect.  With a "
+   "connection object (any group, non-abelian too) the geometric part is its phase: a holonomy table."},
   {"eval", m_eval, "red:eval{q = x[, v = xdot | p = s]} -> {I=, Iinv=, A=, B=, Mtilde=, amended=, routhian=, ...}",
    "Numerical values of the derived objects at a reduced state (xdot = 0 without v or p) with the current mu."},
   {"discrete", dm_lrouth_discrete,
