@@ -1014,9 +1014,15 @@ void dm_open_conn(lua_State *L)
   dm_lua_open_conn_disc(L);
   dm_lua_open_conn_mesh(L);
   lua_settop(L, dm);
-  /* the catalog lua/dmech/bundles.lua: an installer called with dm */
+  /* the catalog lua/dmech/bundles.lua and dm.plot_convergence
+   * (lua/dmech/convergence.lua): installers called with dm */
   lua_getglobal(L, "require");
   lua_pushliteral(L, "dmech.bundles");
+  lua_call(L, 1, 1);
+  lua_pushvalue(L, dm);
+  lua_call(L, 1, 0);
+  lua_getglobal(L, "require");
+  lua_pushliteral(L, "dmech.convergence");
   lua_call(L, 1, 1);
   lua_pushvalue(L, dm);
   lua_call(L, 1, 0);
