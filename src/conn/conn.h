@@ -184,6 +184,11 @@ dm_conn *dm_conn_lagrangian_alloc(dm_expr_ctx *ctx, const dm_conn_bundle *B, con
                                   const dm_expr *xdot, const dm_expr *xi, dm_expr l,
                                   size_t npar, const dm_expr *par, const double *parval,
                                   dm_expr *Aout, dm_err *e);
+/* Compile A_loc of an expression connection to native code (expr/native.h;
+ * x0 a typical shape point for the check against the tape, may be NULL);
+ * later evaluations of A_loc run it.  On failure (DM_ENOTFOUND no
+ * compiler, DM_EFAILED, ...) the tape stays in use. */
+int dm_conn_native(dm_conn *C, const double *x0, dm_err *e);
 /* Parameters of an expression connection (DM_EINVAL for others). */
 int dm_conn_set_params(dm_conn *C, const double *parval, dm_err *e);
 

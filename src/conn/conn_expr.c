@@ -8,12 +8,14 @@
 #include <string.h>
 
 #include "conn/conn_impl.h"
+#include "expr/native.h"
 
 void dm_conn__expr_free(void *ud)
 {
   conn_expr *c = ud;
   if (c == NULL)
     return;
+  dm_native_free(c->nat);
   dm_tape_free(c->tA);
   dm_tape_free(c->tdA);
   free(c->par);
@@ -26,7 +28,10 @@ int dm_conn__expr_eval(void *ud, const double *x, double *A, double *dA, dm_err 
   conn_expr *c = ud;
   (void)e;
   if (dA == NULL) {
-    dm_tape_eval(c->tA, x, c->par, A, c->work);
+    if (c->fA)
+      c->fA(x, c->par, A);
+    else
+      dm_tape_eval(c->tA, x, c->par, A, c->work);
     return DM_OK;
   }
   /* the second tape computes A then dA */
@@ -108,6 +113,21 @@ fail:
   free(out);
   dm_conn__expr_free(c);
   return NULL;
+}
+
+int dm_conn_native(dm_conn *C, const double *x0, dm_err *e)
+{
+  conn_expr *c;
+  int st;
+  if (!C->expr)
+    return dm_err_set(e, DM_EINVAL, "connection: not made from expressions (nothing to compile)");
+  c = C->ud;
+  if (c->fA != NULL)
+    return DM_OK;
+  if ((st = dm_native_compile(c->tA, x0, c->par, &c->nat, e)) != DM_OK)
+    return st;
+  c->fA = dm_native_function(c->nat);
+  return DM_OK;
 }
 
 int dm_conn_set_params(dm_conn *C, const double *parval, dm_err *e)

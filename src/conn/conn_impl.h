@@ -22,6 +22,8 @@ struct dm_conn {
 /* the tapes of an expression connection (conn_expr.c) */
 typedef struct conn_expr {
   dm_tape *tA, *tdA;            /* A; A then dA */
+  struct dm_native *nat;        /* native code of tA, or NULL */
+  void (*fA)(const double *in, const double *par, double *out);
   size_t nA, npar;
   double *par, *work, *out;     /* out: nA (1 + nx) inside work's block */
 } conn_expr;

@@ -232,6 +232,32 @@ int dm_conn_dc_holonomy(dm_conn_dc *D, const double *xs, size_t n, const double 
   if ((st = dm_conn_shape_check(B, xs, "holonomy: point 1", e)) != DM_OK ||
       (st = over_check(B, q0, xs, "holonomy", e)) != DM_OK)
     return st;
+  if (dm_conn_bundle_is_trivial(B) && D->R->hlift == NULL) {
+    /* g_N = g0 P, P = A(x0, x1)^-1 A(x1, x2)^-1 ... (unwrapped angles
+     * compose without reduction): the product directly, no points */
+    for (k = 1; k < n; k++)
+      if ((st = dm_conn_shape_check(B, xs + k * B->nx, "holonomy: a point", e)) != DM_OK)
+        return edge_err(e, st, "holonomy", k);
+    dm_lie_identity(G, t);
+    for (k = 1; k < n; k++) {
+      if ((k & 4095) == 0 && dm_interrupted())
+        return dm_err_set(e, DM_EINTR, "holonomy: interrupted at point %zu of %zu", k + 1, n);
+      if ((st = D->R->local(D, xs + (k - 1) * B->nx, xs + k * B->nx, S, e)) != DM_OK)
+        return edge_err(e, st, "holonomy", k);
+      dm_lie_inverse(G, S, gi);
+      dm_lie_compose(G, t, gi, t);
+    }
+    if (lifted)
+      *lifted = (G->abelian && G->dim == 1) ? t[0] : NAN;
+    if (body)
+      memcpy(body, t, G->nq * sizeof *t);
+    if (spatial) {
+      dm_lie_inverse(G, q0 + B->nx, gi);
+      dm_lie_compose(G, q0 + B->nx, t, S);
+      dm_lie_compose(G, S, gi, spatial);
+    }
+    return DM_OK;
+  }
   memcpy(qa, q0, B->nq * sizeof *q0);
   for (k = 1; k < n; k++) {
     if ((k & 4095) == 0 && dm_interrupted())
@@ -239,18 +265,6 @@ int dm_conn_dc_holonomy(dm_conn_dc *D, const double *xs, size_t n, const double 
     if ((st = dm_conn_dc_hlift(D, qa, xs + k * B->nx, qb, e)) != DM_OK)
       return edge_err(e, st, "holonomy", k);
     memcpy(qa, qb, B->nq * sizeof *qb);
-  }
-  if (dm_conn_bundle_is_trivial(B)) {
-    /* P = g0^-1 gN (unwrapped angles compose without reduction) */
-    dm_lie_inverse(G, q0 + B->nx, gi);
-    dm_lie_compose(G, gi, qa + B->nx, t);
-    if (lifted)
-      *lifted = (G->abelian && G->dim == 1) ? t[0] : NAN;
-    if (body)
-      memcpy(body, t, G->nq * sizeof *t);
-    if (spatial)
-      dm_lie_compose(G, qa + B->nx, gi, spatial);
-    return DM_OK;
   }
   if ((st = dm_conn_fiber_diff(B, q0, qa, S, e)) != DM_OK)
     return st;

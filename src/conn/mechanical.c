@@ -24,6 +24,9 @@
 #include "core/smalllu.h"
 #include "core/numfmt.h"
 
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
 struct conn_mech {
   dm_tape *t;                   /* in: k (G->nq); par: q0, q1, user; out: J, Jac */
   size_t nq, npar, dim;
@@ -32,7 +35,7 @@ struct conn_mech {
   size_t *perm;
   double mu[DM_LIE_DIM_MAX];
   double tol;
-  int maxit;
+  int maxit, sgn;               /* sgn: the extremum's sign (0 until known) */
   unsigned long solves, iters;
 };
 
@@ -211,15 +214,52 @@ int dm_conn_dc_momentum(dm_conn_dc *D, const double *q0, const double *q1, doubl
   return DM_OK;
 }
 
+/* 1 when the symmetric S (n x n, row-major) is positive definite; S is
+ * overwritten by its Cholesky factor (GSL) */
+static int posdef(double *S, size_t n)
+{
+  gsl_matrix_view v = gsl_matrix_view_array(S, n, n);
+  return gsl_linalg_cholesky_decomp1(&v.matrix) == GSL_SUCCESS;
+}
+
+/* The kind of extremum horizontal pairs are: the sign of the Hessian of
+ * k -> Ld(q0, k q1) on the diagonal q1 = q0 (a kinetic energy makes it
+ * definite there: + for a minimum).  Computed once per connection. */
+static int extremum_sign(conn_mech *m, const dm_lie_group *G, const double *q0)
+{
+  double k[DM_LIE_NQ_MAX], tr = 0.0;
+  size_t a;
+  if (m->sgn != 0)
+    return m->sgn;
+  memcpy(m->par, q0, m->nq * sizeof *q0);
+  memcpy(m->par + m->nq, q0, m->nq * sizeof *q0);
+  dm_lie_identity(G, k);
+  eval_J(m, k);
+  for (a = 0; a < m->dim; a++)
+    tr += m->out[m->dim + a * m->dim + a];
+  m->sgn = tr < 0.0 ? -1 : 1;
+  return m->sgn;
+}
+
+/* Newton on the group for J_d(q0, k q1) = mu.  J is the right-trivialized
+ * gradient of f(k) = Ld(q0, k q1) (minus mu), so its solutions are the
+ * critical points of f, and horizontal pairs are the extremum that the
+ * diagonal continues (a minimum for a kinetic energy).  Where the
+ * symmetric part of the Hessian H = Ad_k^T Jac is not definite (of that
+ * sign) the step is the regularized one (H + lambda I) eta = -g, at most
+ * 1 long, which descends f; a limit that is a saddle is an error. */
 int dm_conn__mech_solve(dm_conn_dc *D, const double *q0, const double *q1, double *k, dm_err *e)
 {
   conn_mech *m = D->mech;
   const dm_lie_group *G = D->B->G;
   double eta[DM_LIE_DIM_MAX], E[DM_LIE_NQ_MAX], A[DM_LIE_NQ_MAX], res = HUGE_VAL;
+  double Ad[DM_LIE_DIM_MAX * DM_LIE_DIM_MAX], Hs[DM_LIE_DIM_MAX * DM_LIE_DIM_MAX],
+         S[DM_LIE_DIM_MAX * DM_LIE_DIM_MAX], rhs[DM_LIE_DIM_MAX];
   dm_newton_test t = DM_NEWTON_TEST_INIT;
-  size_t a, dim = m->dim;
-  int it, st;
+  size_t a, b, l, dim = m->dim;
+  int it, st, sgn, pd = 1, saddle = 0;
   char p0[160], p1[160];
+  sgn = extremum_sign(m, G, q0);
   /* the guess: k = A_guess(q0, q1)^-1 */
   if (D->guess != NULL) {
     if ((st = dm_conn_dc_eval(D->guess, q0, q1, A, e)) != DM_OK)
@@ -241,23 +281,79 @@ int dm_conn__mech_solve(dm_conn_dc *D, const double *q0, const double *q1, doubl
     memcpy(m->jac, m->out + dim, dim * dim * sizeof *m->jac);
     if (!isfinite(res))
       break;
-    st = dm_smalllu_factor(m->jac, dim, m->perm);
-    if (st != DM_OK) {
-      dm_num_format_vec(p0, sizeof p0, q0, m->nq);
-      dm_num_format_vec(p1, sizeof p1, q1, m->nq);
-      return dm_err_set(e, DM_ESINGULAR, "discrete mechanical connection: singular momentum "
-                        "Jacobian (the discrete Lagrangian is not group-regular there) at "
-                        "q0 = %s, q1 = %s", p0, p1);
+    /* sgn sym(Ad_k^T Jac) (abelian: Ad = I) */
+    if (G->abelian) {
+      memset(Ad, 0, dim * dim * sizeof *Ad);
+      for (a = 0; a < dim; a++)
+        Ad[a * dim + a] = 1.0;
+    } else {
+      dm_lie_Ad(G, k, Ad, dim);
     }
-    dm_smalllu_solve(m->jac, dim, m->perm, eta);
+    for (a = 0; a < dim; a++)
+      for (b = 0; b < dim; b++) {
+        double s1 = 0.0, s2 = 0.0;
+        for (l = 0; l < dim; l++) {
+          s1 += Ad[l * dim + a] * m->jac[l * dim + b];
+          s2 += Ad[l * dim + b] * m->jac[l * dim + a];
+        }
+        Hs[a * dim + b] = 0.5 * sgn * (s1 + s2);
+      }
+    memcpy(S, Hs, dim * dim * sizeof *S);
+    pd = posdef(S, dim);
+    if (pd) {
+      st = dm_smalllu_factor(m->jac, dim, m->perm);
+      if (st != DM_OK) {
+        dm_num_format_vec(p0, sizeof p0, q0, m->nq);
+        dm_num_format_vec(p1, sizeof p1, q1, m->nq);
+        return dm_err_set(e, DM_ESINGULAR, "discrete mechanical connection: singular momentum "
+                          "Jacobian (the discrete Lagrangian is not group-regular there) at "
+                          "q0 = %s, q1 = %s", p0, p1);
+      }
+      dm_smalllu_solve(m->jac, dim, m->perm, eta);
+    } else {
+      double lam = 1e-12, tr = 0.0, n;
+      int tries;
+      for (a = 0; a < dim; a++) {
+        double s = 0.0;
+        for (l = 0; l < dim; l++)
+          s += Ad[l * dim + a] * eta[l];
+        rhs[a] = sgn * s;
+        tr += fabs(Hs[a * dim + a]);
+      }
+      lam = fmax(lam, tr / (double)dim);
+      for (tries = 0; tries < 80; tries++, lam *= 2.0) {
+        memcpy(S, Hs, dim * dim * sizeof *S);
+        for (a = 0; a < dim; a++)
+          S[a * dim + a] += lam;
+        if (posdef(S, dim))
+          break;
+      }
+      {
+        gsl_matrix_view Sv = gsl_matrix_view_array(S, dim, dim);
+        gsl_vector_view bv = gsl_vector_view_array(rhs, dim), xv = gsl_vector_view_array(eta, dim);
+        gsl_linalg_cholesky_solve(&Sv.matrix, &bv.vector, &xv.vector);
+      }
+      n = dm_conn__norm(eta, dim);
+      if (n > 1.0)
+        for (a = 0; a < dim; a++)
+          eta[a] /= n;
+    }
     dm_lie_exp(G, eta, E);
     dm_lie_compose(G, k, E, k);
     m->iters++;
-    if (dm_newton_done(&t, dm_conn__norm(eta, dim), m->tol))
-      return DM_OK;
+    if (dm_newton_done(&t, dm_conn__norm(eta, dim), m->tol)) {
+      if (pd)
+        return DM_OK;
+      saddle = 1;
+      break;
+    }
   }
   dm_num_format_vec(p0, sizeof p0, q0, m->nq);
   dm_num_format_vec(p1, sizeof p1, q1, m->nq);
+  if (saddle)
+    return dm_err_set(e, DM_ENOCONV, "discrete mechanical connection: Newton ended on a saddle "
+                      "of k -> Ld(q0, k q1), not the extremum the diagonal continues (the pair is "
+                      "too far from the diagonal), at q0 = %s, q1 = %s", p0, p1);
   return dm_err_set(e, DM_ENOCONV, "discrete mechanical connection: Newton did not converge in "
                     "%d iterations (residual %.3g, tolerance %.3g) at q0 = %s, q1 = %s",
                     m->maxit, res, m->tol, p0, p1);

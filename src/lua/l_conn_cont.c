@@ -13,6 +13,7 @@
 #include "lua/l_conn.h"
 #include "lua/l_expr.h"
 #include "lua/l_system.h"
+#include "expr/native.h"
 #include "core/trajectory.h"
 
 typedef struct dm_lconn {
@@ -185,6 +186,20 @@ static void trace_matrix(lua_State *L, int fidx, int xidx, int pidx, size_t r, s
   lua_pop(L, 1);
 }
 
+/* native code for A_loc as dm.config.native says: "never" the tape,
+ * "auto"/"wait" native when a compiler works (at once: a connection is
+ * evaluated a few thousand times, not run in the background), "always"
+ * native or an error */
+static void conn_native(lua_State *L, dm_conn *C)
+{
+  int mode = dm_lua_native_mode(L);
+  dm_err e;
+  if (mode == DM_NATIVE_NEVER)
+    return;
+  if (dm_conn_native(C, NULL, &e) != DM_OK && mode == DM_NATIVE_ALWAYS)
+    dm_lua_fail(L, "connection: native code", e.status, &e);
+}
+
 static const char *const conn_keys[] = {"bundle", "A", "params", NULL};
 
 static int l_connection(lua_State *L)
@@ -218,6 +233,7 @@ static int l_connection(lua_State *L)
   trace_matrix(L, 3, 8, 7, B->G->dim, B->nx, "dm.connection: A(x, p)", c->A);
   if ((c->C = dm_conn_expr_alloc(dm_lua_exprctx(L), B, x, c->A, c->npar, par, pv, &e)) == NULL)
     return dm_lua_fail(L, "dm.connection", e.status, &e);
+  conn_native(L, c->C);
   lua_settop(L, 6);
   return 1;
 }
@@ -260,6 +276,7 @@ static int l_mechanical(lua_State *L)
                               c->A, &e);
     if (c->C == NULL)
       return dm_lua_fail(L, "dm.mechanical_connection", e.status, &e);
+    conn_native(L, c->C);
     lua_settop(L, 8);
     return 1;
   }
@@ -298,6 +315,7 @@ static int l_mechanical(lua_State *L)
   c->C = dm_conn_lagrangian_alloc(dm_lua_exprctx(L), B, x, xd, xi, l, np, par, pv, c->A, &e);
   if (c->C == NULL)
     return dm_lua_fail(L, "dm.mechanical_connection", e.status, &e);
+  conn_native(L, c->C);
   return 1;
 }
 
@@ -605,6 +623,7 @@ void dm_lua_push_conn_exprs(lua_State *L, int gidx, const char *name, size_t nx,
   memcpy(c->A, A, b->B->G->dim * nx * sizeof *A);
   if ((c->C = dm_conn_expr_alloc(dm_lua_exprctx(L), b->B, x, A, npar, par, pv, &e)) == NULL)
     dm_lua_fail(L, "connection", e.status, &e);
+  conn_native(L, c->C);
   lua_replace(L, bidx);
   lua_settop(L, bidx);
 }

@@ -438,6 +438,47 @@ static void test_noether(void)
   dm_lie_group_free(G);
 }
 
+/* free particles on the axes, +-(1,0,0), +-(0,2,0), +-(0,0,3), and Y = R X,
+ * R the rotation by pi about e1: H = sum y x^T = R C is symmetric, so k = e
+ * is a critical point of k -> sum |k y - x|^2 -- a saddle, not the minimum
+ * k = R^-1.  Newton from the identity sits there: an error, not a silent
+ * flip.  With R off by round-off the regularized steps escape to the
+ * minimum. */
+static void test_saddle(void)
+{
+  dm_conn_bundle *B = dm_conn_bundle_particles(6, NULL);
+  const dm_lie_group *G = B->G;
+  dm_expr x[18], y[18], Ld = K(0.0);
+  double X[18] = {1, 0, 0, 0, 2, 0, 0, 0, 3, -1, 0, 0, 0, -2, 0, 0, 0, -3}, Y[18], R[9], A[9],
+         w[3] = {M_PI, 0, 0};
+  dm_conn_dc *D;
+  dm_err e;
+  int i;
+  syms("sx", 18, x);
+  syms("sy", 18, y);
+  for (i = 0; i < 18; i++)
+    Ld = ADD(Ld, MUL(K(5.0), SQ(SUB(y[i], x[i]))));
+  D = dm_conn_dc_mechanical(B, cx, x, y, Ld, 0, NULL, NULL, NULL, 0, 0, &e);
+  memset(R, 0, sizeof R);
+  R[0] = 1.0;
+  R[4] = R[8] = -1.0;
+  for (i = 0; i < 6; i++)
+    dm_lie_act(G, R, X + 3 * i, Y + 3 * i);
+  tap_ok(dm_conn_dc_eval(D, X, Y, A, &e) == DM_ENOCONV && strstr(e.msg, "saddle"),
+         "particles: a pair on a saddle of k -> Ld(q0, k q1) is an error: %s", e.msg);
+  dm_lie_exp(G, w, R);                  /* the same up to round-off */
+  R[1] += 1e-9;
+  dm_lie_normalize(G, R);
+  for (i = 0; i < 6; i++)
+    dm_lie_act(G, R, X + 3 * i, Y + 3 * i);
+  i = dm_conn_dc_eval(D, X, Y, A, NULL);
+  tap_ok(i == DM_OK && dm_lie_dist(G, A, R) < 1e-12,
+         "particles: next to the saddle the regularized steps reach the minimum (%.1e)",
+         dm_lie_dist(G, A, R));
+  dm_conn_dc_free(D);
+  dm_conn_bundle_free(B);
+}
+
 static void test_errors(void)
 {
   dm_lie_group *G = dm_lie_so2(NULL);
@@ -468,6 +509,7 @@ int main(void)
   test_rotor();
   test_particles();
   test_noether();
+  test_saddle();
   test_errors();
   dm_expr_ctx_free(cx);
   return tap_done();

@@ -6,6 +6,7 @@
 -- order test, the trampoline of a user A(x0, x1), and every error message.
 local T = require "dmech.test"
 local dm = require "dmech"
+dm.config.native = "never"   -- the tape: no compiler runs in this test
 local pi = math.pi
 local SO2, SO3 = dm.lie.SO2(), dm.lie.SO3()
 
@@ -181,6 +182,26 @@ T.group("a user local representation", function()
   local tr = dm.discrete_connection{bundle = B, rule = "trivial"}
   T.near(tr(B:point{x = {0, 0}, g = 0.1}, B:point{x = {1, 0}, g = 0.4}):coords()[1], 0.3, 1e-16,
     "trivial connection: A_d = g1 g0^-1")
+end)
+
+T.group("native code", function()
+  dm.config.native = "always"
+  local ok, A = pcall(dm.mechanical_connection, {bundle = dm.bundles.cat()})
+  dm.config.native = "never"
+  if not ok and tostring(A):find("compiler") then
+    T.skip("no C compiler: " .. tostring(A), 1)
+  else
+    T.ok(ok, "native code compiled: " .. tostring(ok and "yes" or A))
+    local Ad = dm.discrete_connection{from = A, rule = "midpoint"}
+    local At = dm.discrete_connection{from = dm.mechanical_connection{bundle = dm.bundles.cat()},
+      rule = "midpoint"}
+    local loop = {}
+    for k = 0, 32 do loop[#loop + 1] = {1 + 0.5 * math.cos(2 * pi * k / 32), 0.5 + 0.5 * math.sin(2 * pi * k / 32)} end
+    loop[#loop] = loop[1]
+    local q0 = dm.bundles.cat():point{x = loop[1], g = 0}
+    T.near(Ad:holonomy(loop, q0).angle, At:holonomy(loop, q0).angle, 1e-15,
+      "native and tape give the same holonomy")
+  end
 end)
 
 T.group("errors", function()
