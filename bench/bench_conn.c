@@ -12,7 +12,8 @@
  *    Kabsch rotation by GSL's SVD, the closed form of the same answer).
  *
  * Each variant runs `reps` times (interleaved after a warm-up), thread CPU
- * time, median.  usage: bench_conn [reps] */
+ * time, median.  usage: bench_conn [reps [native]] (native = 0: the cat's
+ * A_loc runs as a tape, else native code when a compiler works) */
 #include <config.h>
 #include <math.h>
 #include <stdio.h>
@@ -274,7 +275,8 @@ int main(int argc, char **argv)
       }
     }
     printf("holonomy, three-link cat (SO(2)), midpoint, %d vertices:\n", NV);
-    printf("  dmech (A = I^-1 C from l, tapes)  %8.1f ns/vertex\n", 1e9 * median(tA, reps) / NV);
+    printf("  dmech (A = I^-1 C from l, %s)%s %8.1f ns/vertex\n", native ? "native" : "tape",
+           native ? "" : "  ", 1e9 * median(tA, reps) / NV);
     printf("  hand-written C loop               %8.1f ns/vertex\n", 1e9 * median(tB, reps) / NV);
     printf("  ratio dmech/hand %.2f   holonomy %.15f, hand %.15f (diff %.1e)\n\n",
            median(tA, reps) / median(tB, reps), hol, hand, fabs(hol - hand));
@@ -322,7 +324,7 @@ int main(int argc, char **argv)
       for (i = 0; i < 9; i++)
         d = fmax(d, fabs(P[i] - hand[i]));
       printf("holonomy, rotor craft (SO(3)), midpoint, %d vertices:\n", NV);
-      printf("  dmech (A = I^-1 C from l, tapes)  %8.1f ns/vertex\n", 1e9 * median(tA, reps) / NV);
+      printf("  dmech (A = I^-1 C from l, tape)   %8.1f ns/vertex\n", 1e9 * median(tA, reps) / NV);
       printf("  hand-written C loop               %8.1f ns/vertex\n", 1e9 * median(tB, reps) / NV);
       printf("  ratio dmech/hand %.2f   max |P - P_hand| %.1e\n\n", median(tA, reps) / median(tB, reps), d);
     }
