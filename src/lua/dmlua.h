@@ -91,6 +91,9 @@ int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e);
  * dm_lua_run_check_flags checks both options of the table at opts (0: none)
  * up front. */
 int dm_lua_run_ended(lua_State *L, int opts, int status, const char *msg);
+/* "warning: <text>" on a line of its own, through io.stderr, unless
+ * dm.config.warn = false (rank 0 only under MPI). */
+void dm_lua_warning(lua_State *L, const char *text);
 void dm_lua_run_check_flags(lua_State *L, int opts);
 
 /* luaL_typeerror-style message with a free-form expectation:

@@ -671,6 +671,7 @@ static int l_ensemble(lua_State *L)
       lua_pushfstring(L, "dm.ensemble: %d of %d members failed (the first: %s); their status and "
                       "time reached are in the table", (int)sum.failed, (int)sum.members,
                       first ? first : "?");
+    dm_lua_warning(L, lua_tostring(L, -1));       /* nothing fails silently */
     return 2;
   }
   lua_pushfstring(L, "dm.ensemble: %s", e.msg);   /* the output file: table kept */

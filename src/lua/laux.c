@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/mpi.h"
 #include "core/numfmt.h"
 #include "lua/dmlua.h"
 
@@ -148,6 +149,33 @@ void dm_lua_run_check_flags(lua_State *L, int opts)
   run_flag(L, opts, "warn", 1);
 }
 
+/* The warning line itself (rank 0 only under MPI: one line, not one per
+ * rank). */
+static void write_warning(lua_State *L, const char *text)
+{
+  int top = lua_gettop(L);
+  if (dm_mpi_rank() != 0)
+    return;
+  /* through io.stderr, so that a script that redirects it sees it (not
+   * protected: a pending Ctrl-C that stops the script must get through) */
+  if (lua_getglobal(L, "io") == LUA_TTABLE && lua_getfield(L, -1, "stderr") != LUA_TNIL
+      && lua_getfield(L, -1, "write") == LUA_TFUNCTION) {
+    lua_insert(L, -2);
+    lua_pushfstring(L, "warning: %s\n", text);
+    lua_call(L, 2, 0);
+  } else {
+    fprintf(stderr, "warning: %s\n", text);
+    fflush(stderr);
+  }
+  lua_settop(L, top);
+}
+
+void dm_lua_warning(lua_State *L, const char *text)
+{
+  if (run_flag(L, 0, "warn", 1))
+    write_warning(L, text);
+}
+
 int dm_lua_run_ended(lua_State *L, int opts, int status, const char *msg)
 {
   int top = lua_gettop(L), strict, warn;
@@ -159,17 +187,8 @@ int dm_lua_run_ended(lua_State *L, int opts, int status, const char *msg)
   if (strict)
     return luaL_error(L, "run: %s", msg);
   if (warn) {
-    /* through io.stderr, so that a script that redirects it sees it (not
-     * protected: a pending Ctrl-C that stops the script must get through) */
-    if (lua_getglobal(L, "io") == LUA_TTABLE && lua_getfield(L, -1, "stderr") != LUA_TNIL
-        && lua_getfield(L, -1, "write") == LUA_TFUNCTION) {
-      lua_insert(L, -2);
-      lua_pushfstring(L, "warning: run ended early (%s): %s\n", dm_strstatus(status), msg);
-      lua_call(L, 2, 0);
-    } else {
-      fprintf(stderr, "warning: run ended early (%s): %s\n", dm_strstatus(status), msg);
-      fflush(stderr);
-    }
+    lua_pushfstring(L, "run ended early (%s): %s", dm_strstatus(status), msg);
+    write_warning(L, lua_tostring(L, -1));
     lua_settop(L, top);
   }
   lua_pushfstring(L, "run: %s", msg);

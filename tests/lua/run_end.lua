@@ -70,6 +70,16 @@ T.ok(ok and tr.status == "success" and err == "", "a Lie group run: success, no 
 T.error_like(function() B:run(ls, {steps = 1, strict = 1}) end, "option 'strict' must be a boolean",
              "strict checked on Lie group runs too")
 
+-- an ensemble with failed members says so on stderr as well
+do
+  local K = dm.integrator(sys, {method = "gauss", stages = 2, h = 0.01})
+  local e2, okE, res, emsg = stderr_of(dm.ensemble, {integrator = K, members = 4, threads = 1, run = {t = 2},
+    states = function(k) return {q = {k == 2 and 1e-3 or 1, 0}, p = {0, k == 2 and 0 or 1}} end,
+    reduce = {"final"}})
+  T.ok(okE and res and emsg and emsg:find("1 of 4 members failed", 1, true), "the ensemble keeps the table and says 1 of 4 failed")
+  T.is(e2, "warning: " .. tostring(emsg) .. "\n", "and warns on stderr")
+end
+
 -- a reduced state remembers its mu
 local red = dm.routh(dm.systems.j2_cylindrical{J2 = 0.05}, {cyclic = {"theta"}})
 local rs, mu = red:project{q = {1.6, 0, 0}, v = {0, 0.5, 0.25}}

@@ -22,6 +22,7 @@ run_mpi() {
 }
 
 cat > "$tmp/sweep.lua" <<'EOF'
+dm.config.warn = false            -- the message is printed below
 local dir, threads = arg[1], tonumber(arg[2])
 local I = dm.integrator(dm.systems.kepler{impl = "c"}, {method = "gauss", stages = 2, h = 0.01})
 local res, msg = dm.ensemble{integrator = I, members = 37, threads = threads, run = {t = 2},
