@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <gsl/gsl_randist.h>
@@ -715,6 +716,16 @@ static int l_mpi_barrier(lua_State *L)
   return 0;
 }
 
+/* Monotonic wall-clock seconds (MPI_Wtime's meaning, with or without MPI):
+ * os.clock counts the CPU time of every thread. */
+static int l_mpi_wtime(lua_State *L)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  lua_pushnumber(L, (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec);
+  return 1;
+}
+
 static int l_mpi_info(lua_State *L)
 {
   lua_createtable(L, 0, 6);
@@ -751,6 +762,8 @@ static const dm_reg mpi_funcs[] = {
    "The number of MPI ranks running the script (1 without mpirun)."},
   {"barrier", l_mpi_barrier, "dm.mpi.barrier()",
    "Wait until every rank has reached this call (no-op without mpirun)."},
+  {"wtime", l_mpi_wtime, "dm.mpi.wtime() -> seconds",
+   "Wall-clock seconds from an arbitrary origin (monotonic), for timing runs; os.clock counts the CPU time of all threads."},
   {"info", l_mpi_info, "dm.mpi.info() -> {built=, active=, library=, hdf5=, ...}",
    "How this dmech was built and started: MPI support and library, the HDF5 version and whether it writes in parallel."},
   {NULL, NULL, NULL, NULL}
