@@ -193,8 +193,28 @@ static int check_names(const dm_traj *tr, const char *path, dm_err *e)
  * writes rows first, first + stride, ... (0, 1: all); the same selection in
  * memory (tr holds every row) and in the file.  dxpl: the transfer
  * property list (collective under MPI-IO). */
+static int write_columns(hid_t f, const dm_traj *tr, size_t first, size_t stride, hid_t dxpl,
+                         hid_t dcpl, const char *path, dm_err *e);
+
 static int write_file(hid_t f, const dm_traj *tr, size_t first, size_t stride, hid_t dxpl,
                       const char *path, dm_err *e)
+{
+  int st = DM_OK;
+  /* every value is written: no fill values first (they would double the
+   * bytes written) */
+  hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  if (dcpl < 0 || H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER) < 0) {
+    if (dcpl >= 0)
+      H5Pclose(dcpl);
+    return h5_fail(e, DM_EIO, path, "cannot set up a dataset");
+  }
+  st = write_columns(f, tr, first, stride, dxpl, dcpl, path, e);
+  H5Pclose(dcpl);
+  return st;
+}
+
+static int write_columns(hid_t f, const dm_traj *tr, size_t first, size_t stride, hid_t dxpl,
+                         hid_t dcpl, const char *path, dm_err *e)
 {
   size_t i, j, len = dm_traj_len(tr);
   hsize_t dims[1] = {len}, start[1] = {first}, step[1] = {stride};
@@ -219,7 +239,7 @@ static int write_file(hid_t f, const dm_traj *tr, size_t first, size_t stride, h
       return dm_err_set(e, DM_EINTR, "saving '%.200s': interrupted", path);
     }
     if (fs >= 0)
-      d = H5Dcreate2(f, dm_traj_colname(tr, j), H5T_IEEE_F64LE, fs, H5P_DEFAULT, H5P_DEFAULT,
+      d = H5Dcreate2(f, dm_traj_colname(tr, j), H5T_IEEE_F64LE, fs, H5P_DEFAULT, dcpl,
                      H5P_DEFAULT);
     if (d >= 0 && put_string(d, "kind", dm_traj_kindname(dm_traj_colkind(tr, j)))) {
       ok = 1;
