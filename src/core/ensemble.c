@@ -600,6 +600,9 @@ static int check_opts(const dm_integrator *I, const dm_ens_opts *o, dm_run_opts 
     return dm_err_set(e, DM_EINVAL, "need an integrator and options");
   if (o->members < 1)
     return dm_err_set(e, DM_EINVAL, "need members >= 1 (got %ld)", o->members);
+  if (o->members > DM_ENS_MAX_MEMBERS)
+    return dm_err_set(e, DM_EINVAL, "need members <= %ld (got %ld): split the ensemble into "
+                      "several calls", (long)DM_ENS_MAX_MEMBERS, o->members);
   if (o->threads < 0)
     return dm_err_set(e, DM_EINVAL, "need threads >= 1 (0: automatic), got %d", o->threads);
   if (o->start == NULL)

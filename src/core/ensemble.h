@@ -124,6 +124,7 @@ enum dm_ens_reducer {
   (DM_ENS_BIT(DM_ENS_MEGNO) | DM_ENS_BIT(DM_ENS_FLI) | DM_ENS_BIT(DM_ENS_LYAPUNOV))
 
 #define DM_ENS_MAX_MESSAGES 100   /* failure messages kept as metadata */
+#define DM_ENS_MAX_MEMBERS 1000000000000L   /* 10^12 members per call */
 
 /* Member k's start: q, p (n each); par (npar, preset to the system's
  * values) only with opts.params.  Return DM_OK, or a status with e filled

@@ -353,6 +353,10 @@ static void errors(void)
   o.members = 0;
   st = dm_ensemble_run(I, &o, &t, NULL, &e);
   tap_ok(st == DM_EINVAL && strcmp(e.msg, "need members >= 1 (got 0)") == 0, "%s", e.msg);
+  o.members = 4611686018427387904L;
+  st = dm_ensemble_run(I, &o, &t, NULL, &e);
+  tap_ok(st == DM_EINVAL && strstr(e.msg, "need members <= 1000000000000 (got 4611686018427387904)"),
+         "%s", e.msg);
   o.members = 2;
   o.reduce = 0;
   o.run.every = 0;
