@@ -1,5 +1,5 @@
 /* bench_ensemble.c -- the ensemble driver and its HDF5 output against their
- * references, ratios printed in one run (doc/ensembles.md §9):
+ * references, ratios printed in one run (doc/ensembles.md §8):
  *
  *  1. threads: a MEGNO ensemble (the built-in C J2 satellite, Gauss s = 2,
  *     the exact step Jacobian every step) on 1 and on 2 threads; the ratio
