@@ -248,5 +248,168 @@ return function(dm, C)
         end}
     end)
 
+  -- {==== large systems: lattices, N bodies, a string ========================
+  -- Coordinates are arrays (dm.coords): q.x[i] in L, traj.q.x[i] after a run.
+
+  -- the chain's size and its ends from the options
+  local function chain_opts(fname, o, defaults)
+    local p, ex = params(fname, o, defaults, {"n", "ends"})
+    local n = ex.n or 32
+    if math.type(n) ~= "integer" or n < 2 then
+      error(("dm.systems.%s: n must be an integer >= 2, got %s"):format(fname, tostring(ex.n)), 3)
+    end
+    local ends = ex.ends or "fixed"
+    if ends ~= "fixed" and ends ~= "periodic" then
+      error(("dm.systems.%s: ends must be \"fixed\" or \"periodic\", got %s"):format(fname, tostring(ends)), 3)
+    end
+    return p, n, ends
+  end
+
+  -- the bond stretches r_0 .. r_n (fixed ends: x_0 = x_{n+1} = 0) or r_1 .. r_n (periodic)
+  local function bonds(x, n, ends)
+    local r = {}
+    if ends == "fixed" then
+      r[#r + 1] = x[1]
+      for i = 1, n - 1 do r[#r + 1] = x[i + 1] - x[i] end
+      r[#r + 1] = -x[n]
+    else
+      for i = 1, n - 1 do r[#r + 1] = x[i + 1] - x[i] end
+      r[#r + 1] = x[1] - x[n]
+    end
+    return r
+  end
+
+  def("fpu", "dm.systems.fpu{n=32, alpha=0, beta=1, k=1, m=1, ends=\"fixed\"|\"periodic\"} -> system",
+    "Fermi-Pasta-Ulam-Tsingou chain of n masses (coordinates x[1..n], displacements): L = sum m v_i^2/2 - sum_bonds (k r^2/2 + alpha r^3/3 + beta r^4/4), r the stretch of each bond, ends fixed (x_0 = x_{n+1} = 0) or periodic; beta > 0 is the FPU-beta chain, whose energy put in the lowest mode comes back (recurrence) instead of equipartitioning on short times.",
+    function(o)
+      local p, n, ends = chain_opts("fpu", o, {{"alpha", 0}, {"beta", 1}, {"k", 1}, {"m", 1}})
+      return dm.system{name = "FPU chain", coords = dm.coords("x", n), params = p,
+        L = function(q, v, p)
+          local T, V = 0, 0
+          for i = 1, n do T = T + v.x[i]^2 end
+          for _, r in ipairs(bonds(q.x, n, ends)) do
+            V = V + 0.5 * p.k * r^2 + p.alpha / 3 * r^3 + 0.25 * p.beta * r^4
+          end
+          return 0.5 * p.m * T - V
+        end}
+    end)
+
+  def("toda", "dm.systems.toda{n=32, a=1, b=1, m=1, ends=\"periodic\"|\"fixed\"} -> system",
+    "Toda lattice of n particles (coordinates x[1..n]): L = sum m v_i^2/2 - sum_bonds (a/b) exp(-b r), r = x_{i+1} - x_i (periodic: the bond x_1 - x_n closes the ring, where the lattice is completely integrable: the traces of the powers of its Lax matrix are conserved, see dm.systems.toda_integrals); with fixed ends x_0 = x_{n+1} = 0.",
+    function(o)
+      local p, n, ends = chain_opts("toda", o, {{"a", 1}, {"b", 1}, {"m", 1}})
+      if o == nil or o.ends == nil then ends = "periodic" end
+      return dm.system{name = "Toda lattice", coords = dm.coords("x", n), params = p,
+        L = function(q, v, p)
+          local T, V = 0, 0
+          for i = 1, n do T = T + v.x[i]^2 end
+          for _, r in ipairs(bonds(q.x, n, ends)) do V = V + p.a / p.b * dm.exp(-p.b * r) end
+          return 0.5 * p.m * T - V
+        end}
+    end)
+
+  -- tr L^k, k = 1 .. kmax, of the periodic Toda lattice's Lax matrix in
+  -- Flaschka's variables: L symmetric tridiagonal and periodic, diagonal
+  -- beta_i = -p_i sqrt(b/(4 m a)), off-diagonal alpha_i = exp(-b r_i/2)/2
+  -- between i and i+1 (and n and 1), r_i = x_{i+1} - x_i; with these
+  -- scalings dL/dt = sqrt(a b/m) [B, L] for the lattice of dm.systems.toda.
+  -- (L^k)_jj from k products with the unit vector e_j, whose support stays
+  -- within k sites of j: O(n k^2) in all.
+  function S.toda_integrals(q, p, kmax, o)
+    o = o or {}
+    local n, a, b, m = #q, o.a or 1, o.b or 1, o.m or 1
+    kmax = kmax or 4
+    local kappa = -math.sqrt(b / (4 * m * a))
+    local beta, alpha = {}, {}
+    for i = 1, n do
+      beta[i] = kappa * p[i]
+      alpha[i] = 0.5 * math.exp(-0.5 * b * ((i < n and q[i + 1] or q[1]) - q[i]))
+    end
+    local tr = {}
+    for k = 1, kmax do tr[k] = 0 end
+    for j = 1, n do
+      local cur = {[j] = 1.0}
+      for k = 1, kmax do
+        local nxt = {}
+        for i, c in pairs(cur) do
+          local ip, im = i % n + 1, (i - 2) % n + 1
+          nxt[i] = (nxt[i] or 0) + beta[i] * c
+          nxt[ip] = (nxt[ip] or 0) + alpha[i] * c
+          nxt[im] = (nxt[im] or 0) + alpha[im] * c
+        end
+        cur = nxt
+        tr[k] = tr[k] + (cur[j] or 0)
+      end
+    end
+    return tr
+  end
+  dm.doc("dm.systems.toda_integrals", "dm.systems.toda_integrals(q, p[, kmax=4][, {a=1, b=1, m=1}]) -> {tr L, tr L^2, ...}",
+    "The first kmax conserved quantities tr L^k of the periodic Toda lattice (dm.systems.toda with these parameters) at positions q and momenta p (lists of n numbers): L is the Lax matrix in Flaschka's variables, diagonal -p_i sqrt(b/(4 m a)), off-diagonal exp(-b (x_{i+1} - x_i)/2)/2, periodic (tr L^2 = H b/(2a)); O(n kmax^2) operations.",
+    S.toda_integrals)
+
+  def("nbody", "dm.systems.nbody{n=3, dim=2, G=1, masses={...}, soft=0} -> system",
+    "Newtonian N-body problem, n bodies in the plane (dim = 2: coordinates x[1..n], y[1..n]) or in space (dim = 3: and z[1..n]): L = sum m_i |v_i|^2/2 + sum_{i<j} G m_i m_j / sqrt(|q_i - q_j|^2 + soft^2); masses m_i (default 1) are parameters m1 .. mn; momentum and angular momentum are conserved.",
+    function(o)
+      o = o or {}
+      local n, dim, masses = o.n or 3, o.dim or 2, o.masses
+      local rest = {}
+      for k, v in pairs(o) do if k ~= "n" and k ~= "dim" and k ~= "masses" then rest[k] = v end end
+      local p = params("nbody", rest, {{"G", 1}, {"soft", 0}})
+      if math.type(n) ~= "integer" or n < 2 then
+        error(("dm.systems.nbody: n must be an integer >= 2, got %s"):format(tostring(o.n)), 2)
+      end
+      if dim ~= 2 and dim ~= 3 then
+        error(("dm.systems.nbody: dim must be 2 or 3, got %s"):format(tostring(dim)), 2)
+      end
+      if masses ~= nil and (type(masses) ~= "table" or #masses ~= n) then
+        error(("dm.systems.nbody: masses must be a list of %d numbers"):format(n), 2)
+      end
+      for i = 1, n do p[#p + 1] = {"m" .. i, masses and masses[i] or 1} end
+      local axes = dim == 2 and {"x", "y"} or {"x", "y", "z"}
+      local coords = {}
+      for _, a in ipairs(axes) do coords[#coords + 1] = dm.coords(a, n) end
+      return dm.system{name = ("%d-body problem (%d-D)"):format(n, dim), coords = coords, params = p,
+        L = function(q, v, p)
+          local T, U = 0, 0
+          for i = 1, n do
+            local s = 0
+            for _, a in ipairs(axes) do s = s + v[a][i]^2 end
+            T = T + p["m" .. i] * s
+          end
+          for i = 1, n do
+            for j = i + 1, n do
+              local d2 = p.soft^2
+              for _, a in ipairs(axes) do d2 = d2 + (q[a][i] - q[a][j])^2 end
+              U = U + p["m" .. i] * p["m" .. j] / dm.sqrt(d2)
+            end
+          end
+          return 0.5 * T + p.G * U
+        end}
+    end)
+
+  def("string", "dm.systems.string{n=64, length=1, tension=1, density=1} -> system",
+    "A string of the given length and tension, fixed at both ends, discretized by n interior nodes (coordinates u[1..n], transverse displacements, spacing dx = length/(n+1)): L = sum density dx v_i^2/2 - sum_bonds tension dx (sqrt(1 + ((u_{i+1} - u_i)/dx)^2) - 1), the exact stretching energy of each segment -- the nonlinear string; for small slopes the wave equation with speed sqrt(tension/density).",
+    function(o)
+      local p, ex = params("string", o, {{"density", 1}, {"length", 1}, {"tension", 1}}, {"n"})
+      local n = ex.n or 64
+      if math.type(n) ~= "integer" or n < 1 then
+        error(("dm.systems.string: n must be an integer >= 1, got %s"):format(tostring(ex.n)), 2)
+      end
+      return dm.system{name = "nonlinear string", coords = dm.coords("u", n), params = p,
+        L = function(q, v, p)
+          local dx = p.length / (n + 1)
+          local T, V = 0, 0
+          for i = 1, n do T = T + v.u[i]^2 end
+          local prev = 0
+          for i = 1, n + 1 do
+            local cur = i <= n and q.u[i] or 0
+            local s = (cur - prev) / dx
+            V = V + (dm.sqrt(1 + s^2) - 1)
+            prev = cur
+          end
+          return 0.5 * p.density * dx * T - p.tension * dx * V
+        end}
+    end)
+
   dm.systems = S
 end
