@@ -81,6 +81,26 @@ static const char *time_text(run *r, long k)
   return r->t_text;
 }
 
+static size_t sink_block(const dm_run_opts *o)
+{
+  return o->sink_every > 0 ? (size_t)o->sink_every : 4096;
+}
+
+/* The samples held so far to the sink, then dropped. */
+static int flush(run *r, dm_err *e)
+{
+  dm_err le;
+  dm_err_clear(&le);
+  if (dm_traj_len(r->tr) == 0)
+    return DM_OK;
+  int st = r->o->sink(r->o->sink_ctx, r->tr, &le);
+  dm_traj_clear(r->tr);
+  if (st != DM_OK)
+    return dm_err_set(e, st, "step %ld of %ld (t = %s): the sink failed: %s", r->k,
+                      r->o->nsteps, time_text(r, r->k), le.msg[0] ? le.msg : dm_strstatus(st));
+  return DM_OK;
+}
+
 /* Record the state after r->k steps: velocity, energy, momenta; the
  * runaway tests.  DM_EDIVERGED for a non-finite state (not recorded) or
  * energy (recorded, then the run stops). */
@@ -114,6 +134,9 @@ static int record(run *r, dm_err *e)
                       r->k, o->nsteps, time_text(r, r->k), le.msg);
   r->last = r->k;
   r->samples++;
+  if (o->sink != NULL && dm_traj_len(r->tr) >= sink_block(o) &&
+      (st = flush(r, e)) != DM_OK)
+    return st;
   if (!r->check_E)
     return DM_OK;
   if (r->samples == 1)
@@ -162,6 +185,29 @@ static int check_args(const dm_integrator *I, const double *q, const double *p,
   return DM_OK;
 }
 
+/* Samples the trajectory holds at most at once. */
+static size_t held_samples(const dm_run_opts *o)
+{
+  size_t want = (size_t)(o->nsteps > 0 ? o->nsteps : 0) / (size_t)o->every + 2;
+  return o->sink != NULL && sink_block(o) < want ? sink_block(o) : want;
+}
+
+size_t dm_run_bytes(const dm_integrator *I, const dm_run_opts *o)
+{
+  size_t cols = 1 + 3 * I->n + (o->energy ? 1 : 0);
+  for (size_t i = 0; o->momentum != NULL && i < I->n; i++)
+    cols += o->momentum[i] != 0;
+  long nsteps = o->nsteps;
+  if (nsteps < 0 && isfinite(o->t_end) && isfinite(o->h) && o->h != 0.0 &&
+      dm_run_steps_to(o->t0, o->t_end, o->h, &nsteps, NULL) != DM_OK)
+    nsteps = 0;
+  dm_run_opts t = *o;
+  t.nsteps = nsteps < 0 ? 0 : nsteps;
+  if (t.every < 1)
+    t.every = 1;
+  return held_samples(&t) * cols * sizeof(double);
+}
+
 /* Diagnostic columns and the metadata known before the run. */
 static int prepare(run *r, dm_err *e)
 {
@@ -192,11 +238,10 @@ static int prepare(run *r, dm_err *e)
     snprintf(key, sizeof key, "param.%s", s->params ? s->params[i] : "?");
     st = dm_traj_meta_set_number(r->tr, key, s->par[i], e);
   }
-  /* best effort; beyond 2^20 samples the storage grows by doubling */
-  if (st == DM_OK) {
-    long want = o->nsteps / o->every + 2;
-    dm_traj_reserve(r->tr, (size_t)(want < (1L << 20) ? want : 1L << 20), NULL);
-  }
+  /* exactly the samples the run will hold at once (best effort: without
+   * it the storage grows by doubling) */
+  if (st == DM_OK)
+    dm_traj_reserve(r->tr, held_samples(o), NULL);
   return st;
 }
 
@@ -333,6 +378,16 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
     record(&r, &ign);
   }
 done:
+  if (o.sink != NULL) {
+    /* the rest to the sink; the last sample stays */
+    dm_err se;
+    int fs = flush(&r, st == DM_OK ? e : &se);
+    if (fs != DM_OK && st == DM_OK)
+      st = fs;
+    if (r.last >= 0 && r.last == r.k)
+      dm_traj_append(tr, o.t0 + (double)r.last * o.h, r.q, r.p, r.v, r.extra, NULL);
+  }
+  dm_traj_shrink(tr);                /* 8 bytes per number stored */
   if (st != DM_OK) {
     size_t len = strlen(e->msg);
     snprintf(e->msg + len, sizeof e->msg - len, "; the trajectory up to there is kept");

@@ -32,6 +32,13 @@
  * trajectory of the wrong shape or not empty, a non-finite start) change
  * nothing.
  *
+ * Memory.  The trajectory's storage is reserved once for the samples the
+ * run will record and trimmed to them at the end: 8 bytes per stored
+ * number plus a constant.  With a sink, the trajectory holds at most
+ * sink_every samples: each time it has that many (and at the end, also an
+ * early one) the sink gets them and they are dropped; the trajectory
+ * returned then holds the last sample only (the sink had it too).
+ *
  * Progress.  With a progress callback the run goes in pieces of `piece`
  * steps (0: sized to about 0.1 s of computing each) and calls it after each
  * piece; without one it is one piece.  Pieces never change the numbers: a
@@ -67,6 +74,11 @@ typedef struct dm_run_progress {
 /* Return 0 to go on, non-zero to stop the run (DM_EINTR). */
 typedef int (*dm_run_progress_fn)(void *ctx, const dm_run_progress *pr);
 
+/* Streaming: called with the trajectory holding the samples recorded since
+ * the last call (in order; its columns and metadata as ever); return
+ * DM_OK, or a status (and a message in e) to stop the run with it. */
+typedef int (*dm_run_sink_fn)(void *ctx, const dm_traj *tr, dm_err *e);
+
 typedef struct dm_run_opts {
   double t0;              /* start time (0) */
   double h;               /* step: finite, != 0 (NaN: not set) */
@@ -79,6 +91,9 @@ typedef struct dm_run_opts {
   long piece;             /* steps per progress call (0: automatic) */
   dm_run_progress_fn progress;    /* NULL: none */
   void *progress_ctx;
+  dm_run_sink_fn sink;    /* NULL: every sample stays in the trajectory */
+  void *sink_ctx;
+  long sink_every;        /* samples per call of the sink (0: 4096) */
 } dm_run_opts;
 
 /* How the run went (also on the trajectory as metadata). */
@@ -96,6 +111,11 @@ void dm_run_opts_init(dm_run_opts *o);
  * three numbers) when t_end cannot be reached (non-finite, behind the
  * start, or more than 9e15 steps). */
 int dm_run_steps_to(double t0, double t_end, double h, long *nsteps, dm_err *e);
+
+/* Bytes the trajectory of a run with these options will hold at most (the
+ * samples at once -- all of them, or sink_every with a sink -- times the
+ * columns, 8 bytes each), for a warning before memory runs out. */
+size_t dm_run_bytes(const dm_integrator *I, const dm_run_opts *o);
 
 /* An empty trajectory for runs of I: its coordinates, p and v columns. */
 dm_traj *dm_run_traj_alloc(const dm_integrator *I, dm_err *e);

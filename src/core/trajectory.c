@@ -333,6 +333,24 @@ int dm_traj_reserve(dm_traj *tr, size_t nsamples, dm_err *e)
   return DM_OK;
 }
 
+void dm_traj_shrink(dm_traj *tr)
+{
+  size_t j, nc = tr->len > 0 ? tr->len : 1;
+  if (nc >= tr->cap)
+    return;
+  for (j = 0; j < tr->ncols; j++) {
+    double *x = realloc(tr->cols[j].x, nc * sizeof *x);
+    if (x != NULL)               /* refused: that column keeps its room */
+      tr->cols[j].x = x;
+  }
+  tr->cap = nc;                  /* every column holds at least nc */
+}
+
+size_t dm_traj_bytes(const dm_traj *tr)
+{
+  return tr->cap * tr->ncols * sizeof(double);
+}
+
 void dm_traj_clear(dm_traj *tr)
 {
   tr->len = 0;

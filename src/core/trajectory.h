@@ -97,6 +97,12 @@ int dm_traj_reserve(dm_traj *tr, size_t nsamples, dm_err *e);
 
 /* Remove every sample (columns, names and metadata stay). */
 void dm_traj_clear(dm_traj *tr);
+/* Give back the storage beyond the samples held (at least one sample's
+ * room stays): 8 bytes per stored number.  Never fails (a shrink the
+ * allocator refuses leaves the storage as it is). */
+void dm_traj_shrink(dm_traj *tr);
+/* Bytes of the sample storage held (the columns' room: 8 per number). */
+size_t dm_traj_bytes(const dm_traj *tr);
 
 /* ---- appending ------------------------------------------------------------- */
 
@@ -250,6 +256,21 @@ int dm_traj_save(const dm_traj *tr, const char *path, dm_err *e);
 
 /* Write the CSV text to a stream (no atomicity; `name` is used in messages). */
 int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e);
+/* Only the rows of the samples (after a dm_traj_write of the same columns:
+ * a file written in pieces). */
+int dm_traj_write_rows(const dm_traj *tr, FILE *f, const char *name, dm_err *e);
+
+/* A CSV file written in pieces as a long run goes (the run driver's sink,
+ * run.h): the first put writes the header (the metadata known then) and
+ * the samples, later ones the samples; close makes the file appear at
+ * path, as dm_traj_save would (temporary file, rename), also after an
+ * early end of the run -- what was put is kept; abandon removes it.
+ * Errors as dm_traj_save's; a stream that failed keeps failing. */
+typedef struct dm_traj_stream dm_traj_stream;
+int dm_traj_stream_open(const char *path, dm_traj_stream **s, dm_err *e);
+int dm_traj_stream_put(dm_traj_stream *s, const dm_traj *tr, dm_err *e);
+int dm_traj_stream_close(dm_traj_stream *s, dm_err *e);      /* NULL: DM_OK */
+void dm_traj_stream_abandon(dm_traj_stream *s);              /* NULL: no-op */
 
 /* Load a trajectory saved by dm_traj_save (or a plain CSV, see above).
  * NULL + DM_EIO (cannot open/read), DM_EINVAL (malformed: "f.csv:7: expected

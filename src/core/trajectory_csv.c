@@ -101,6 +101,16 @@ int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
   return st;
 }
 
+int dm_traj_write_rows(const dm_traj *tr, FILE *f, const char *name, dm_err *e)
+{
+  locale_t old = dm_num_enter();
+  int st;
+  errno = 0;
+  st = write_body(tr, f, name ? name : "(stream)", e);
+  dm_num_leave(old);
+  return st;
+}
+
 int dm_traj_save(const dm_traj *tr, const char *path, dm_err *e)
 {
   dm_outfile o;

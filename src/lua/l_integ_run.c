@@ -62,7 +62,8 @@ static void progress_end(progress *pg)
  * ======================================================================= */
 
 static const char *const run_keys[] = {"steps", "t", "every", "progress", "energy", "momentum",
-                                       "h", "chunk", "max_energy_error", "strict", "warn", NULL};
+                                       "h", "chunk", "max_energy_error", "strict", "warn", "sink",
+                                       "sink_every", NULL};
 
 static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, unsigned char *mom)
 {
@@ -100,7 +101,8 @@ static void check_keys(lua_State *L, int o)
       k++;
     if (key == NULL || *k == NULL)
       luaL_error(L, "run: unknown option %s (options: steps, t, every, progress, energy, "
-                 "momentum, h, chunk, max_energy_error, strict, warn)", luaL_tolstring(L, -2, NULL));
+                 "momentum, h, chunk, max_energy_error, strict, warn, sink, sink_every)",
+                 luaL_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
 }
@@ -164,6 +166,114 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int
 
 /* }====================================================================== */
 
+/* {======================================================================
+ * streaming (sink) and the memory warning
+ * ======================================================================= */
+
+/* What the sink sends samples to: a Lua function (called under pcall
+ * from inside the run: its error stops the run and is reported after
+ * it), or a CSV file written in pieces. */
+typedef struct sinkctx {
+  lua_State *L;
+  int fn, traj;             /* stack slots of the function and the trajectory */
+  dm_traj_stream *file;
+} sinkctx;
+
+static int sink_call(void *ctx, const dm_traj *tr, dm_err *e)
+{
+  sinkctx *sc = ctx;
+  if (sc->file != NULL)
+    return dm_traj_stream_put(sc->file, tr, e);
+  lua_State *L = sc->L;
+  lua_pushvalue(L, sc->fn);
+  lua_pushvalue(L, sc->traj);
+  if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
+    dm_err_set(e, DM_EFAILED, "%s", luaL_tolstring(L, -1, NULL));
+    lua_pop(L, 2);
+    return DM_EFAILED;
+  }
+  return DM_OK;
+}
+
+/* sink = function(traj) | "file.csv", sink_every = k into r / sc (the
+ * file opened). */
+static void read_sink(lua_State *L, int o, dm_run_opts *r, sinkctx *sc)
+{
+  int type = lua_getfield(L, o, "sink");
+  if (type == LUA_TNIL) {
+    lua_pop(L, 1);
+    return;
+  }
+  lua_Integer k = dm_optintegerfield(L, o, "sink_every", 4096);
+  if (k < 1)
+    luaL_error(L, "run: sink_every must be >= 1, got %d", (int)k);
+  r->sink_every = (long)k;
+  if (type == LUA_TFUNCTION) {
+    sc->fn = lua_gettop(L);
+  } else if (type == LUA_TSTRING) {
+    dm_err e;
+    if (dm_traj_stream_open(lua_tostring(L, -1), &sc->file, &e) != DM_OK)
+      luaL_error(L, "run: sink: %s", e.msg);
+    lua_pop(L, 1);
+  } else {
+    luaL_error(L, "run: option 'sink' must be a function(traj) or a file name (.csv), got %s",
+               luaL_typename(L, -1));
+  }
+  r->sink = sink_call;
+  r->sink_ctx = sc;
+}
+
+/* dm.config.memory_limit (bytes), else half of the physical memory; the
+ * warn flag: options, else dm.config.warn, else on. */
+static double memory_limit(lua_State *L, int opts, int *warn)
+{
+  double lim = 0;
+  int top = lua_gettop(L);
+  *warn = 1;
+  if (lua_getfield(L, LUA_REGISTRYINDEX, DM_LUA_DMTABLE) == LUA_TTABLE &&
+      lua_getfield(L, -1, "config") == LUA_TTABLE) {
+    if (lua_getfield(L, -1, "memory_limit") == LUA_TNUMBER)
+      lim = lua_tonumber(L, -1);
+    if (lua_getfield(L, -2, "warn") == LUA_TBOOLEAN)
+      *warn = lua_toboolean(L, -1);
+  }
+  if (lua_istable(L, opts) && lua_getfield(L, opts, "warn") == LUA_TBOOLEAN)
+    *warn = lua_toboolean(L, -1);
+  lua_settop(L, top);
+  if (lim > 0)
+    return lim;
+  long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
+  return pages > 0 && psize > 0 ? 0.5 * (double)pages * (double)psize : 0;
+}
+
+/* A warning (through io.stderr, like the run's other warnings) before a
+ * run whose trajectory would take more than the limit. */
+static void warn_memory(lua_State *L, int opts, const dm_linteg *li, const dm_run_opts *r)
+{
+  int warn, top = lua_gettop(L);
+  double bytes = (double)dm_run_bytes(li->I, r), lim = memory_limit(L, opts, &warn);
+  if (!warn || !(lim > 0 && bytes > lim))
+    return;
+  char msg[512];
+  dm_num_snprintf(msg, sizeof msg, "warning: run: the trajectory will take %.3g MB (%ld steps, "
+                  "every %ld, %zu coordinates), above dm.config.memory_limit = %.3g MB; record "
+                  "less often (every = ...) or stream the samples (sink = \"file.csv\" or a "
+                  "function, sink_every = ...)\n", bytes / 1048576.0, r->nsteps, r->every,
+                  li->ls->n, lim / 1048576.0);
+  if (lua_getglobal(L, "io") == LUA_TTABLE && lua_getfield(L, -1, "stderr") != LUA_TNIL &&
+      lua_getfield(L, -1, "write") == LUA_TFUNCTION) {
+    lua_insert(L, -2);
+    lua_pushstring(L, msg);
+    lua_call(L, 2, 0);
+  } else {
+    fputs(msg, stderr);
+    fflush(stderr);
+  }
+  lua_settop(L, top);
+}
+
+/* }====================================================================== */
+
 int dm_linteg_run(lua_State *L)
 {
   dm_linteg *li = dm_linteg_check(L, 1);
@@ -191,14 +301,27 @@ int dm_linteg_run(lua_State *L)
     r.progress = progress_draw;
     r.progress_ctx = &pg;
   }
-  dm_traj *tr = dm_pushtraj(L, n, li->ls->sys.coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V); /* 5 */
+  sinkctx sc = { L, 0, 0, NULL };
+  read_sink(L, 3, &r, &sc);                      /* the function stays: 5 */
+  warn_memory(L, 3, li, &r);
+  dm_traj *tr = dm_pushtraj(L, n, li->ls->sys.coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V);
+  int tslot = lua_gettop(L);
+  sc.traj = tslot;
   st = dm_run(li->I, s.q, s.p, &r, tr, &res, &e);
   progress_end(&pg);
+  if (sc.file != NULL) {                         /* the file appears, also after an early end */
+    dm_err ce;
+    int cs = dm_traj_stream_close(sc.file, &ce);
+    if (cs != DM_OK && st == DM_OK) {
+      st = cs;
+      e = ce;
+    }
+  }
   if (st == DM_EINTR)
     dm_interrupt_clear();
   if (st != DM_OK && res.samples == 0)
     return dm_lua_fail(L, "run", st, &e);
-  lua_settop(L, 5);
+  lua_settop(L, tslot);
   if (st == DM_OK)
     return 1;
   return 1 + dm_lua_run_ended(L, 3, st, e.msg);

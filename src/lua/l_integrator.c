@@ -585,7 +585,7 @@ static const dm_reg integ_methods[] = {
    "One step from {q=, p=} or {q=, v=} (t optional) to a new state {t, q, p, v}; a Newton "
    "failure returns nil and a message with the residual and tolerance."},
   {"run", dm_linteg_run,
-   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=, max_energy_error=, strict=false, warn=true}) -> traj[, message]",
+   "integ:run(state, {steps= | t=, every=1, h=, progress=, energy=true, momentum={coords}, chunk=, max_energy_error=, strict=false, warn=true, sink=, sink_every=4096}) -> traj[, message]",
    "Integrate in C to step `steps` or time t, recording every `every` steps a Trajectory with "
    "t, q, p, v, energy and momentum_<coord> columns (cyclic coordinates by default); Ctrl-C, a "
    "failure (Newton, domain) or a runaway (non-finite state or energy; |E - E0| > "
@@ -594,7 +594,12 @@ static const dm_reg integ_methods[] = {
    "it stopped, with a warning on stderr (warn = false or dm.config.warn = false: none); "
    "strict = true (or dm.config.strict) makes an early end an error; traj:meta() records "
    "method, stages, h, order, steps, status and message; progress (default: stdout is a "
-   "terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update."},
+   "terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update.  sink = function(traj) or "
+   "\"file.csv\" streams the samples: every sink_every samples (and at the end) the function "
+   "gets a trajectory holding them, or they are appended to the file (which appears at the end, "
+   "also an early one), then dropped, and the run returns the last sample only; a run whose "
+   "trajectory would take more than dm.config.memory_limit bytes (default half the physical "
+   "memory) prints a warning first."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
    "step equations (exact Jacobians)."},
