@@ -72,6 +72,16 @@ void dm_lua_pushmatvals(lua_State *L, size_t r, size_t c, int sym, const double 
 /* Raise the expression context's error after a failed symbolic call. */
 int dm_lua_lie_symfail(lua_State *L, const char *fname, const dm_err *e);
 
+/* Objects whose functions are bound to them (G.exp, S.log): a metatable
+ * with __methods = funcs registered under "<prefix><name>"; __index from
+ * meta should call dm_lua_bound_index, which returns (and caches in user
+ * value 1) a closure passing the object first, else calls fields(L). */
+void dm_lua_newclass_bound(lua_State *L, const char *tname, const char *name,
+                           const char *prefix, const dm_reg *funcs, const luaL_Reg *meta);
+int dm_lua_bound_index(lua_State *L, const char *prefix, int (*fields)(lua_State *));
+
+int dm_lua_lie_sphere(lua_State *L);      /* dm.lie.sphere (l_lie_sphere.c) */
+void dm_lua_open_liesphere(lua_State *L);
 void dm_lua_open_lieelem(lua_State *L);   /* the element class (l_lie_elem.c) */
 void dm_open_lie(lua_State *L);           /* dm.lie (l_lie.c) */
 
