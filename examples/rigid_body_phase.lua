@@ -118,7 +118,7 @@ dm.plot{
   {{bs, pred, with = "lines lw 2", legend = "-Lambda + 2 H T, Lambda by holonomy"},
    {bs, meas, with = "points pt 6 ps 1.5", legend = "measured on the lgvi run (mod 2 pi, nearest branch)"},
    title = "Montgomery's formula across cone angles (400 steps per period)",
-   xlabel = "cone angle b of Pi(0) (rad)", ylabel = "phase (rad)", key = "top left"},
+   xlabel = "cone angle b of Pi(0) (rad)", ylabel = "phase (rad)"},   -- the long key goes below
   dm.plot_convergence{h = Ns, errors = {{"phase error", err}}, orders = {2}, panel = true,
     xlabel = "step h", ylabel = "|phase error| (rad)",
     title = "lgvi: the phase converges at second order"},

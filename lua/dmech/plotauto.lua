@@ -124,7 +124,10 @@ end
 local function key_size(titles, fw, fh, cw, lh)
   local maxlen = 0
   for _, t in ipairs(titles) do maxlen = math.max(maxlen, utf8.len(t) or #t) end
-  return (maxlen * cw + 9 * cw) / fw, (#titles * lh + lh / 2) / fh
+  -- key text runs a little wider than tic labels (about 9 pixels a
+  -- character), plus the sample line and the gaps
+  local kc = cw > 1 and cw + 1 or cw
+  return (maxlen * kc + 10 * kc) / fw, (#titles * lh + lh / 2) / fh
 end
 
 -- A tic step for [a, b] whose labels fit in `avail` (pixels) at `size`
@@ -163,7 +166,7 @@ end
 -- else below the plot.
 local function place_key(samples, styles, kw, kh, rx, ry, o)
   local lo, hi = {rx[1], ry[1]}, {rx[2], ry[2]}
-  if not (lo[1] < hi[1]) or not (lo[2] < hi[2]) or kw > 0.7 or kh > 0.8 then
+  if not (lo[1] < hi[1]) or not (lo[2] < hi[2]) or kw > 0.8 or kh > 0.8 then
     return "below"
   end
   local m = 0.02
