@@ -4,11 +4,13 @@
 #include <config.h>
 #include "core/run.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "core/interrupt.h"
 #include "core/numfmt.h"
 
 void dm_run_opts_init(dm_run_opts *o)
@@ -61,7 +63,8 @@ static int finite_vec(const double *x, size_t n)
 
 typedef struct run {
   dm_integrator *I;
-  const dm_run_opts *o;
+  dm_run_opts *o;         /* the run's copy: nsteps is set when a run "until"
+                           * reaches t_end */
   dm_traj *tr;
   size_t n;
   double *q, *p;          /* the caller's state, advanced in place */
@@ -72,13 +75,32 @@ typedef struct run {
   double E0;
   long k, last;           /* steps done; step of the last sample (-1: none) */
   size_t samples;
-  char t_text[DM_NUM_BUFSIZE];
+  int varstep;            /* the integrator keeps the physical time (I->t) */
+  int until;              /* varstep run to t_end: nsteps unknown until reached */
+  double *q1, *p1;        /* n each: the step of an "until" run */
+  char t_text[DM_NUM_BUFSIZE], of_text[32];
 } run;
+
+/* The time after k steps: t0 + k h, or the integrator's own clock. */
+static double time_at(const run *r, long k)
+{
+  return r->varstep ? r->I->t : r->o->t0 + (double)k * r->o->h;
+}
 
 static const char *time_text(run *r, long k)
 {
-  dm_num_format(r->t_text, sizeof r->t_text, r->o->t0 + (double)k * r->o->h);
+  dm_num_format(r->t_text, sizeof r->t_text, time_at(r, k));
   return r->t_text;
+}
+
+/* " of <nsteps>" (empty while a run "until" t_end does not know it) */
+static const char *of_text(run *r)
+{
+  if (r->until)
+    r->of_text[0] = '\0';
+  else
+    snprintf(r->of_text, sizeof r->of_text, " of %ld", r->o->nsteps);
+  return r->of_text;
 }
 
 static size_t sink_block(const dm_run_opts *o)
@@ -96,10 +118,11 @@ static int flush(run *r, dm_err *e)
   int st = r->o->sink(r->o->sink_ctx, r->tr, &le);
   dm_traj_clear(r->tr);
   if (st != DM_OK)
-    return dm_err_set(e, st, "step %ld of %ld (t = %s): the sink failed: %s", r->k,
-                      r->o->nsteps, time_text(r, r->k), le.msg[0] ? le.msg : dm_strstatus(st));
+    return dm_err_set(e, st, "step %ld%s (t = %s): the sink failed: %s", r->k, of_text(r),
+                      time_text(r, r->k), le.msg[0] ? le.msg : dm_strstatus(st));
   return DM_OK;
 }
+
 
 /* Record the state after r->k steps: velocity, energy, momenta; the
  * runaway tests.  DM_EDIVERGED for a non-finite state (not recorded) or
@@ -112,12 +135,12 @@ static int record(run *r, dm_err *e)
   dm_err le;
   int st;
   if (!finite_vec(r->q, n) || !finite_vec(r->p, n))
-    return dm_err_set(e, DM_EDIVERGED, "the state became non-finite (NaN or Inf) by step %ld "
-                      "of %ld (t = %s): the run diverged", r->k, o->nsteps, time_text(r, r->k));
+    return dm_err_set(e, DM_EDIVERGED, "the state became non-finite (NaN or Inf) by step %ld"
+                      "%s (t = %s): the run diverged", r->k, of_text(r), time_text(r, r->k));
   if ((st = dm_integrator_velocity(r->I, r->q, r->p, r->v, r->have_v, &le)) != DM_OK) {
     if (r->last >= 0)
-      return dm_err_set(e, st, "step %ld of %ld (t = %s): no velocity for the state: %s", r->k,
-                        o->nsteps, time_text(r, r->k), le.msg);
+      return dm_err_set(e, st, "step %ld%s (t = %s): no velocity for the state: %s", r->k,
+                        of_text(r), time_text(r, r->k), le.msg);
     return dm_err_set(e, st, "%s", le.msg);
   }
   r->have_v = 1;
@@ -128,10 +151,11 @@ static int record(run *r, dm_err *e)
   for (i = 0; i < n; i++)
     if (o->momentum != NULL && o->momentum[i])
       r->extra[j++] = r->p[i];
-  if ((st = dm_traj_append(r->tr, o->t0 + (double)r->k * o->h, r->q, r->p, r->v, r->extra,
-                           &le)) != DM_OK)
-    return dm_err_set(e, st, "step %ld of %ld (t = %s): the sample could not be stored: %s",
-                      r->k, o->nsteps, time_text(r, r->k), le.msg);
+  if (r->varstep)
+    r->extra[j++] = r->I->dt;
+  if ((st = dm_traj_append(r->tr, time_at(r, r->k), r->q, r->p, r->v, r->extra, &le)) != DM_OK)
+    return dm_err_set(e, st, "step %ld%s (t = %s): the sample could not be stored: %s",
+                      r->k, of_text(r), time_text(r, r->k), le.msg);
   r->last = r->k;
   r->samples++;
   if (o->sink != NULL && dm_traj_len(r->tr) >= sink_block(o) &&
@@ -142,15 +166,15 @@ static int record(run *r, dm_err *e)
   if (r->samples == 1)
     r->E0 = E;
   if (!isfinite(E))
-    return dm_err_set(e, DM_EDIVERGED, "the energy became non-finite at step %ld of %ld "
-                      "(t = %s): the run diverged", r->k, o->nsteps, time_text(r, r->k));
+    return dm_err_set(e, DM_EDIVERGED, "the energy became non-finite at step %ld%s "
+                      "(t = %s): the run diverged", r->k, of_text(r), time_text(r, r->k));
   if (o->max_energy_error > 0 && fabs(E - r->E0) > o->max_energy_error * fmax(1.0, fabs(r->E0))) {
     char a[DM_NUM_BUFSIZE], b[DM_NUM_BUFSIZE];
     dm_num_format(a, sizeof a, fabs(E - r->E0));
     dm_num_format(b, sizeof b, o->max_energy_error);
     return dm_err_set(e, DM_EDIVERGED, "the energy error |E - E0| = %s exceeds "
-                      "max_energy_error = %s x max(1, |E0|) at step %ld of %ld (t = %s): the run "
-                      "diverged", a, b, r->k, o->nsteps, time_text(r, r->k));
+                      "max_energy_error = %s x max(1, |E0|) at step %ld%s (t = %s): the run "
+                      "diverged", a, b, r->k, of_text(r), time_text(r, r->k));
   }
   return DM_OK;
 }
@@ -224,6 +248,9 @@ static int prepare(run *r, dm_err *e)
       snprintf(name, sizeof name, "%s%s", DM_TRAJ_MOMENTUM, dm_traj_coord(r->tr, i));
       st = dm_traj_add_column(r->tr, name, DM_TRAJ_DIAG, NULL, 0, e);
     }
+  /* variable physical steps: their lengths as a column */
+  if (st == DM_OK && r->varstep)
+    st = dm_traj_add_column(r->tr, "h", DM_TRAJ_DIAG, NULL, 0, e);
   if (st == DM_OK && s->name != NULL)
     st = dm_traj_meta_set(r->tr, "system", s->name, e);
   if (st == DM_OK)
@@ -239,9 +266,15 @@ static int prepare(run *r, dm_err *e)
     st = dm_traj_meta_set_number(r->tr, key, s->par[i], e);
   }
   /* exactly the samples the run will hold at once (best effort: without
-   * it the storage grows by doubling) */
-  if (st == DM_OK)
+   * it the storage grows by doubling); a run "until" t_end guesses */
+  if (st == DM_OK && r->until) {
+    dm_run_opts t = *o;
+    double guess = (o->t_end - o->t0) / o->h;
+    t.nsteps = guess < 1e6 ? (long)guess : 1000000L;
+    dm_traj_reserve(r->tr, held_samples(&t), NULL);
+  } else if (st == DM_OK) {
     dm_traj_reserve(r->tr, held_samples(o), NULL);
+  }
   return st;
 }
 
@@ -251,13 +284,15 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
 static void finish(run *r, int st, const dm_err *e, dm_run_result *res)
 {
   dm_traj_meta_set_number(r->tr, "steps", (double)r->k, NULL);
+  if (r->varstep)
+    dm_traj_meta_set_number(r->tr, "t_end", time_at(r, r->k), NULL);
   dm_traj_meta_set_number(r->tr, "status", st, NULL);
   dm_traj_meta_set(r->tr, "message", st != DM_OK ? e->msg : NULL, NULL);
   if (res != NULL) {
     res->status = st;
     res->steps = r->k;
     res->nsteps = r->o->nsteps;
-    res->t = r->o->t0 + (double)r->k * r->o->h;
+    res->t = time_at(r, r->k);
     res->samples = r->samples;
     res->residual = r->I->stats.residual;
     res->tol = r->I->stats.tol;
@@ -270,10 +305,45 @@ static void finish(run *r, int st, const dm_err *e, dm_run_result *res)
 
 /* Steps up to `end`, recording at every multiple of `every` and at the last
  * step.  On failure e holds the run's message. */
+/* A run "until" t_end with variable physical steps: one step at a time,
+ * the last one shortened by the integrator to end at t_end. */
+static int advance_until(run *r, long end, dm_err *e)
+{
+  dm_run_opts *o = r->o;
+  size_t n = r->n;
+  dm_err le;
+  while (r->k < end) {
+    int st, reached = 0;
+    if (dm_interrupted())
+      return dm_err_set(e, DM_EINTR, "interrupted after step %ld (t = %s)", r->k,
+                        time_text(r, r->k));
+    dm_err_clear(&le);
+    st = dm_integrator_step_until(r->I, o->h, o->t_end, r->q, r->p, r->q1, r->p1, &reached,
+                                  &le);
+    if (st != DM_OK)
+      return dm_err_set(e, st, "step %ld from t = %s failed: %s", r->k + 1, time_text(r, r->k),
+                        le.msg[0] ? le.msg : dm_strstatus(st));
+    memcpy(r->q, r->q1, n * sizeof *r->q);
+    memcpy(r->p, r->p1, n * sizeof *r->p);
+    r->k++;
+    if (reached) {
+      o->nsteps = r->k;
+      r->until = 0;
+    }
+    if ((reached || r->k % o->every == 0) && (st = record(r, e)) != DM_OK)
+      return st;
+    if (reached)
+      break;
+  }
+  return DM_OK;
+}
+
 static int advance_to(run *r, long end, dm_err *e)
 {
   const dm_run_opts *o = r->o;
   dm_err le;
+  if (r->until)
+    return advance_until(r, end, e);
   while (r->k < end) {
     long next = (r->k / o->every + 1) * o->every, stop, got = 0;
     int st;
@@ -284,10 +354,10 @@ static int advance_to(run *r, long end, dm_err *e)
     st = dm_integrator_advance(r->I, o->h, stop - r->k, r->q, r->p, &got, &le);
     r->k += got;
     if (st == DM_EINTR)
-      return dm_err_set(e, DM_EINTR, "interrupted after step %ld of %ld (t = %s)", r->k,
-                        o->nsteps, time_text(r, r->k));
+      return dm_err_set(e, DM_EINTR, "interrupted after step %ld%s (t = %s)", r->k,
+                        of_text(r), time_text(r, r->k));
     if (st != DM_OK)
-      return dm_err_set(e, st, "step %ld of %ld from t = %s failed: %s", r->k + 1, o->nsteps,
+      return dm_err_set(e, st, "step %ld%s from t = %s failed: %s", r->k + 1, of_text(r),
                         time_text(r, r->k), le.msg[0] ? le.msg : dm_strstatus(st));
     if (r->k == next && (st = record(r, e)) != DM_OK)
       return st;
@@ -305,12 +375,24 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
   long P;
   int st, bg;
   dm_err_clear(e);
+  memset(&r, 0, sizeof r);
+  r.varstep = dm_integrator_varstep(I);
+  if (r.varstep && isfinite(o.t_end) && o.nsteps < 0 && isfinite(o.h) && o.h != 0.0) {
+    /* physical time is the integrator's: step until t_end is reached */
+    if ((st = dm_run_steps_to(o.t0, o.t_end, o.h, &o.nsteps, e)) != DM_OK)
+      return st;
+    if (o.t_end != o.t0) {
+      r.until = 1;
+      o.nsteps = LONG_MAX / 2;
+    } else {
+      o.nsteps = 0;
+    }
+  }
   if (isfinite(o.t_end) && o.nsteps < 0 && isfinite(o.h) && o.h != 0.0
       && (st = dm_run_steps_to(o.t0, o.t_end, o.h, &o.nsteps, e)) != DM_OK)
     return st;
   if ((st = check_args(I, q, p, &o, tr, e)) != DM_OK)
     return st;
-  memset(&r, 0, sizeof r);
   r.I = I;
   r.o = &o;
   r.tr = tr;
@@ -319,9 +401,15 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
   r.p = p;
   r.last = -1;
   r.check_E = o.energy || o.max_energy_error > 0;
-  if ((r.v = calloc(2 * r.n + 1, sizeof *r.v)) == NULL)
+  if ((r.v = calloc(4 * r.n + 2, sizeof *r.v)) == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
   r.extra = r.v + r.n;
+  r.q1 = r.extra + r.n + 2;
+  r.p1 = r.q1 + r.n;
+  if ((st = dm_integrator_begin(I, o.h, o.t0, q, p, e)) != DM_OK) {
+    free(r.v);
+    return st;
+  }
   if ((st = prepare(&r, e)) != DM_OK || (st = record(&r, e)) != DM_OK) {
     if (r.samples == 0) {
       dm_traj_clear(tr);
@@ -357,12 +445,15 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
       double tn = now(), dt = tn - piece_start;
       pr.step = r.k;
       pr.nsteps = o.nsteps;
-      pr.t = o.t0 + (double)r.k * o.h;
+      pr.t = time_at(&r, r.k);
+      if (r.until)                 /* estimated from the time reached */
+        pr.nsteps = pr.t != o.t0 ? (long)((double)r.k * (o.t_end - o.t0) / (pr.t - o.t0))
+                                 : r.k + 1;
       pr.elapsed = tn - start;
       if (o.progress(o.progress_ctx, &pr) != 0) {
         if (r.k < o.nsteps)
-          st = dm_err_set(e, DM_EINTR, "stopped by the progress callback after step %ld of "
-                          "%ld (t = %s)", r.k, o.nsteps, time_text(&r, r.k));
+          st = dm_err_set(e, DM_EINTR, "stopped by the progress callback after step %ld"
+                          "%s (t = %s)", r.k, of_text(&r), time_text(&r, r.k));
         break;
       }
       if (o.piece == 0) {          /* aim at ~0.1 s per piece */
@@ -385,7 +476,7 @@ done:
     if (fs != DM_OK && st == DM_OK)
       st = fs;
     if (r.last >= 0 && r.last == r.k)
-      dm_traj_append(tr, o.t0 + (double)r.last * o.h, r.q, r.p, r.v, r.extra, NULL);
+      dm_traj_append(tr, time_at(&r, r.last), r.q, r.p, r.v, r.extra, NULL);
   }
   dm_traj_shrink(tr);                /* 8 bytes per number stored */
   if (st != DM_OK) {

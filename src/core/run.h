@@ -17,6 +17,17 @@
  * param.<name>; when the run ends: steps (completed), status (the DM_*
  * code, 0 for a complete run) and, for an early end, message.
  *
+ * Variable physical steps.  With an integrator whose families keep the
+ * physical time themselves (DM_INTEG_VARSTEP: time transformations,
+ * energy-momentum methods) h is the nominal step they are given; the
+ * run calls dm_integrator_begin at the start, the sample times are the
+ * integrator's clock I->t, a diagnostic column "h" holds the physical
+ * length of the step that ended at each sample (at the start: of the
+ * first step, as begin() knows it), and a run to t_end (nsteps = -1)
+ * steps until the integrator reports it has reached t_end exactly, the
+ * last step shortened (dm_integrator_step_until); metadata t_end is the
+ * time reached.
+ *
  * Early ends keep everything computed so far.  The run stops, records the
  * last good state if it is not a sample already, and returns the status:
  *  - DM_EINTR     dm_interrupted() (Ctrl-C), polled before every step, or

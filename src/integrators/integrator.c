@@ -50,6 +50,7 @@ void dm_integ_opts_init(dm_integ_opts *o)
   o->epsabs = 1e-10;
   o->epsrel = 1e-10;
   strcpy(o->linear, "auto");
+  o->power = 1.0;
 }
 
 const dm_option_desc *dm_integ_option_find(const char *name)
@@ -133,7 +134,8 @@ static void known_methods(const char *kind, char *buf, size_t len)
     if (!dm_integrator_accepts(t, kind))
       continue;
     k += (size_t)snprintf(buf + k, len - k, "%s%s%s", k ? ", " : "", t->name,
-                          strcmp(t->name, "gsl") == 0 ? ":<stepper>" : "");
+                          strcmp(t->name, "gsl") == 0 ? ":<stepper>"
+                          : strcmp(t->name, "adapt") == 0 ? ":<method>" : "");
     for (a = t->names; a != NULL && *a != NULL && k < len; a++)
       k += (size_t)snprintf(buf + k, len - k, ", %s", *a);
   }
@@ -250,6 +252,7 @@ void dm_integrator_reset(dm_integrator *I)
   memset(&I->stats, 0, sizeof I->stats);
   I->stats.linear = linear;
   I->stats.nnz = nnz;
+  I->begun = 0;
 }
 
 static int finite_vec(const double *x, size_t n)
@@ -269,7 +272,70 @@ int dm_integrator_step(dm_integrator *I, double h, const double *q0, const doubl
     return dm_err_set(e, DM_EINVAL, "step size h = %g is not finite", h);
   if (I->sys->update != NULL)          /* a step boundary: background code */
     I->sys->update(I->sys);
+  if (dm_integrator_varstep(I) && !I->begun
+      && (st = dm_integrator_begin(I, h, 0.0, q0, p0, e)) != DM_OK)
+    return st;
   if ((st = I->type->step(I, h, q0, p0, q1, p1, e)) != DM_OK)
+    return st;
+  if (!finite_vec(q1, I->n) || !finite_vec(p1, I->n))
+    return dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
+  if (!dm_integrator_varstep(I)) {
+    I->t += h;
+    I->dt = h;
+  }
+  return DM_OK;
+}
+
+int dm_integrator_begin(dm_integrator *I, double h, double t0, const double *q0,
+                        const double *p0, dm_err *e)
+{
+  int st;
+  if (!isfinite(h) || h == 0.0 || !isfinite(t0))
+    return dm_err_set(e, DM_EINVAL, "begin: need a finite step h != 0 and a finite start time");
+  I->begun = 0;
+  if (dm_integrator_varstep(I) && I->type->begin != NULL) {
+    if ((st = I->type->begin(I, h, t0, q0, p0, e)) != DM_OK)
+      return st;
+  } else {
+    I->t = t0;
+    I->dt = h;
+  }
+  I->begun = 1;
+  return DM_OK;
+}
+
+int dm_integrator_step_until(dm_integrator *I, double h, double t_end, const double *q0,
+                             const double *p0, double *q1, double *p1, int *reached,
+                             dm_err *e)
+{
+  int st;
+  *reached = 0;
+  if (!isfinite(h) || h == 0.0 || !isfinite(t_end))
+    return dm_err_set(e, DM_EINVAL, "step_until: need a finite step h != 0 and a finite end");
+  if (!dm_integrator_varstep(I) || I->type->step_until == NULL) {
+    double rest = t_end - I->t, hh = h;
+    if (rest * h <= 0.0 || fabs(rest) <= fabs(h)) {
+      hh = rest;
+      *reached = 1;
+    }
+    if (hh == 0.0) {
+      memmove(q1, q0, I->n * sizeof *q1);
+      memmove(p1, p0, I->n * sizeof *p1);
+      return DM_OK;
+    }
+    if ((st = dm_integrator_step(I, hh, q0, p0, q1, p1, e)) != DM_OK) {
+      *reached = 0;
+      return st;
+    }
+    if (*reached)
+      I->t = t_end;
+    return DM_OK;
+  }
+  if (I->sys->update != NULL)
+    I->sys->update(I->sys);
+  if (!I->begun && (st = dm_integrator_begin(I, h, 0.0, q0, p0, e)) != DM_OK)
+    return st;
+  if ((st = I->type->step_until(I, h, t_end, q0, p0, q1, p1, reached, e)) != DM_OK)
     return st;
   if (!finite_vec(q1, I->n) || !finite_vec(p1, I->n))
     return dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);

@@ -52,6 +52,21 @@ typedef struct dm_integrator dm_integrator;
 
 #define DM_INTEG_STRMAX 32
 
+/* A monitor function of a time transformation (methods "adapt:<method>",
+ * src/integrators/adapt.c): the physical time runs as dt/ds = g(q) > 0 in
+ * the fictitious time s of the steps.  eval fills g and, when the bits of
+ * `what` ask, the gradient gq (n) and the Hessian gqq (n x n, row-major)
+ * at q with the system's parameters par; it returns 0, > 0 outside its
+ * domain, < 0 on failure (system.h).  Re-entrant with its own work
+ * (work_size bytes).  Borrowed by the integrators: it must outlive them. */
+enum { DM_MON_G = 1u, DM_MON_GRAD = 2u, DM_MON_HESS = 4u };
+typedef struct dm_monitor {
+  int (*eval)(void *data, const double *q, const double *par, unsigned what, double *g,
+              double *gq, double *gqq, void *work);
+  void *data;
+  size_t work_size;
+} dm_monitor;
+
 typedef struct dm_integ_opts {
   int stages;          /* gauss >= 1, lobatto >= 2 (0: family default) */
   double h;            /* default step size of run() (informational here) */
@@ -66,6 +81,10 @@ typedef struct dm_integ_opts {
   double epsabs, epsrel;         /* gsl adaptive tolerances */
   const dm_tableau *tableau;     /* prk: user tableau (copied by new()) */
   char linear[DM_INTEG_STRMAX];  /* Newton matrices: auto (default), dense, sparse */
+  const dm_monitor *monitor;     /* adapt: the monitor (borrowed); NULL: the
+                                  * potential's, (U(q0)/U(q))^power, U = -V */
+  double power;        /* adapt: exponent of the potential's monitor (1:
+                        * Sundman's dt = r ds for a 1/r potential) */
 } dm_integ_opts;
 
 enum dm_opt_kind { DM_OPT_INT, DM_OPT_DOUBLE, DM_OPT_BOOL, DM_OPT_STRING };
@@ -102,7 +121,10 @@ enum dm_integ_flags {
   DM_INTEG_FORCES      = 1u << 4,  /* supports a generalized force */
   DM_INTEG_CONSTRAINTS = 1u << 5,  /* supports holonomic constraints */
   DM_INTEG_ADAPTIVE    = 1u << 6,  /* steps internally with error control */
-  DM_INTEG_EXACT_JAC   = 1u << 7   /* jacobian() is exact (else finite differences) */
+  DM_INTEG_EXACT_JAC   = 1u << 7,  /* jacobian() is exact (else finite differences) */
+  DM_INTEG_VARSTEP     = 1u << 8   /* the physical length of a step is the family's
+                                    * (time transformations, energy-momentum
+                                    * methods): see begin/step_until, I->t, I->dt */
 };
 
 typedef struct dm_integrator_type {
@@ -140,6 +162,18 @@ typedef struct dm_integrator_type {
   /* Further method names the family answers to besides `name` (the
    * instance sees the one requested in I->name), NULL-ended; may be NULL. */
   const char *const *names;
+  /* Families with variable physical steps (DM_INTEG_VARSTEP; NULL for the
+   * others).  begin: start a run at physical time t0 from (q0, p0) with
+   * the nominal step h -- latch what the run keeps fixed (an energy
+   * level), set I->t = t0 and I->dt to the length of the first step (or
+   * its first-order estimate).  Every step then advances I->t by the step's
+   * physical length and sets I->dt to it.  step_until: one step of nominal
+   * size h that, when it would pass the physical time t_end, is replaced by
+   * a shorter one ending there exactly (I->t = t_end, *reached = 1). */
+  int (*begin)(dm_integrator *I, double h, double t0, const double *q0, const double *p0,
+               dm_err *e);
+  int (*step_until)(dm_integrator *I, double h, double t_end, const double *q0,
+                    const double *p0, double *q1, double *p1, int *reached, dm_err *e);
 } dm_integrator_type;
 
 /* Statistics of the last step and running totals. */
@@ -153,6 +187,8 @@ typedef struct dm_integ_stats {
   int linear;           /* the Newton matrices: DM_LINEAR_DENSE or _SPARSE (core/sparse.h;
                            0 for explicit methods) */
   size_t nnz;           /* entries of a sparse Newton matrix */
+  long flagged;         /* steps a family flagged since new() or reset (sem:
+                         * "energy not matched", sem.h) */
 } dm_integ_stats;
 
 struct dm_integrator {
@@ -168,6 +204,11 @@ struct dm_integrator {
                                     * 0 when the notion does not apply */
   unsigned flags;                  /* actual dm_integ_flags */
   dm_integ_stats stats;
+  double t, dt;                    /* the physical time reached and the length of
+                                    * the last step: kept by the VARSTEP
+                                    * families (see begin); dm_integrator_step
+                                    * keeps them for the others */
+  int begun;                       /* begin() ran since new() or reset */
   void *state;                     /* family private */
   struct dm_legendre_ws *leg;      /* Legendre-map workspace (velocity solves) */
   double *scratch;                 /* 8n doubles for the generic layer */
@@ -222,6 +263,21 @@ void dm_integrator_reset(dm_integrator *I);
  * inputs.  Checks the result for NaN (DM_EDOM). */
 int dm_integrator_step(dm_integrator *I, double h, const double *q0, const double *p0,
                        double *q1, double *p1, dm_err *e);
+
+/* Families with variable physical steps (DM_INTEG_VARSTEP).  begin: the
+ * type's begin for those (a family that steps before begin was called
+ * begins at t0 = 0 from the first step's start), else I->t = t0 and
+ * I->dt = h.  step_until: the type's step_until for those; for the others
+ * a step of h, or of t_end - I->t when that is shorter (same sign as h). */
+int dm_integrator_begin(dm_integrator *I, double h, double t0, const double *q0,
+                        const double *p0, dm_err *e);
+int dm_integrator_step_until(dm_integrator *I, double h, double t_end, const double *q0,
+                             const double *p0, double *q1, double *p1, int *reached,
+                             dm_err *e);
+static inline int dm_integrator_varstep(const dm_integrator *I)
+{
+  return (I->flags & DM_INTEG_VARSTEP) != 0;
+}
 
 /* {==== state conversions ================================================ */
 

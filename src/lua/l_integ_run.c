@@ -139,6 +139,12 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int
     if (steps < 0)
       luaL_error(L, "run: steps must be >= 0, got %d", (int)steps);
     r->nsteps = (long)steps;
+  } else if (dm_integrator_varstep(li->I)) {
+    /* the integrator keeps the physical time: the run steps until t */
+    r->t_end = dm_optnumberfield(L, o, "t", 0);
+    if (dm_run_steps_to(r->t0, r->t_end, r->h, &r->nsteps, &e) != DM_OK)
+      luaL_error(L, "run: %s", e.msg);
+    r->nsteps = -1;
   } else if (dm_run_steps_to(r->t0, dm_optnumberfield(L, o, "t", 0), r->h, &r->nsteps, &e)
              != DM_OK) {
     luaL_error(L, "run: %s", e.msg);

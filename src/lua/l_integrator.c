@@ -320,7 +320,8 @@ static int i_step(lua_State *L)
   memcpy(v1, s.v, n * sizeof *v1);
   if ((st = dm_integrator_velocity(li->I, q1, p1, v1, 1, &e)) != DM_OK)
     return soft_fail(L, "step", st, &e);
-  dm_linteg_pushstate(L, li, s.t + h, q1, p1, v1);
+  /* variable physical steps: the step's own length */
+  dm_linteg_pushstate(L, li, s.t + (dm_integrator_varstep(li->I) ? li->I->dt : h), q1, p1, v1);
   return 1;
 }
 
@@ -457,7 +458,7 @@ static int i_reset(lua_State *L)
 
 static void push_stats(lua_State *L, const dm_integ_stats *s)
 {
-  lua_createtable(L, 0, 6);
+  lua_createtable(L, 0, 7);
   lua_pushinteger(L, s->iters);
   lua_setfield(L, -2, "iters");
   lua_pushinteger(L, s->jacs);
@@ -470,6 +471,8 @@ static void push_stats(lua_State *L, const dm_integ_stats *s)
   lua_setfield(L, -2, "steps");
   lua_pushinteger(L, s->iters_total);
   lua_setfield(L, -2, "iters_total");
+  lua_pushinteger(L, s->flagged);
+  lua_setfield(L, -2, "flagged");
 }
 
 static int flag_field(lua_State *L, const dm_linteg *li, const char *k)
@@ -477,7 +480,7 @@ static int flag_field(lua_State *L, const dm_linteg *li, const char *k)
   static const struct { const char *name; unsigned bit; } flags[] = {
     {"symplectic", DM_INTEG_SYMPLECTIC}, {"symmetric", DM_INTEG_SYMMETRIC},
     {"explicit", DM_INTEG_EXPLICIT}, {"variational", DM_INTEG_VARIATIONAL},
-    {"exact_jacobian", DM_INTEG_EXACT_JAC}
+    {"exact_jacobian", DM_INTEG_EXACT_JAC}, {"variable_steps", DM_INTEG_VARSTEP}
   };
   for (size_t i = 0; i < sizeof flags / sizeof flags[0]; i++)
     if (strcmp(k, flags[i].name) == 0) {
@@ -518,7 +521,7 @@ static int integ_index(lua_State *L)
   } else if (!flag_field(L, li, k)) {
     return luaL_error(L, "integrator has no field or method '%s' (fields: h, method, family, stages, "
                       "order, system, stats, summary, symplectic, symmetric, explicit, "
-                      "variational, exact_jacobian)", k);
+                      "variational, exact_jacobian, variable_steps)", k);
   }
   return 1;
 }
@@ -599,7 +602,8 @@ static const dm_reg integ_methods[] = {
    "gets a trajectory holding them, or they are appended to the file (which appears at the end, "
    "also an early one), then dropped, and the run returns the last sample only; a run whose "
    "trajectory would take more than dm.config.memory_limit bytes (default half the physical "
-   "memory) prints a warning first."},
+   "memory) prints a warning first; for methods with variable steps (integ.variable_steps) t "
+   "is the physical time, a column h holds the step lengths and t = T ends exactly at T."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
    "step equations (exact Jacobians)."},
@@ -655,12 +659,16 @@ static const dm_field integ_fields[] = {
   {"explicit", "integ.explicit -> boolean", "True for an explicit method."},
   {"variational", "integ.variational -> boolean", "True for a variational integrator (a discrete Lagrangian)."},
   {"exact_jacobian", "integ.exact_jacobian -> boolean", "True when Newton uses the exact Jacobian of the step."},
+  {"variable_steps", "integ.variable_steps -> boolean",
+   "True when the physical length of a step is the method's own (adapt = {...}, sem): runs record "
+   "the physical time in t and the step lengths in a column h, and t = T ends exactly at T."},
   {NULL, NULL, NULL}
 };
 
 void dm_open_integrator(lua_State *L)
 {
   dm_linteg_open_opts(L);
+  dm_linteg_open_adapt(L);
   dm_newclass(L, DM_INTEG_MT, "integrator", integ_methods, integ_meta);
   lua_getfield(L, -1, "__methods");
   lua_pushcclosure(L, integ_index, 1);
