@@ -80,6 +80,40 @@ static void comp_free(dm_integrator *I)
   I->state = NULL;
 }
 
+/* The scheme named `want`, or for "" the default of the order. */
+static const comp_scheme *find_scheme(const char *want, int order, dm_err *e)
+{
+  size_t i;
+  if (!want[0]) {
+    want = order == 4 ? "yoshida4" : order == 6 ? "kahanli6" : order == 8 ? "kahanli8" : NULL;
+    if (want == NULL) {
+      dm_err_set(e, DM_EINVAL, "composition: order = %d not available (4, 6 or 8)", order);
+      return NULL;
+    }
+  }
+  for (i = 0; i < sizeof schemes / sizeof schemes[0]; i++)
+    if (strcmp(want, schemes[i].name) == 0)
+      return &schemes[i];
+  dm_err_set(e, DM_ENOTFOUND, "composition: unknown scheme '%s' (known: yoshida4, "
+             "yoshida6, kahanli6, mclachlan8, kahanli8)", want);
+  return NULL;
+}
+
+int dm_composition_coeffs(const char *scheme, int order, double *g, size_t *s,
+                          int *order_out, dm_err *e)
+{
+  dm_err le;
+  const comp_scheme *sc = find_scheme(scheme, order, &le);
+  size_t i;
+  if (sc == NULL)
+    return dm_err_set(e, le.status, "%s", le.msg);
+  for (i = 0; i < sc->s; i++)
+    g[i] = sc->half[i < (sc->s + 1) / 2 ? i : sc->s - 1 - i];
+  *s = sc->s;
+  *order_out = sc->order;
+  return DM_OK;
+}
+
 static int comp_alloc(dm_integrator *I, dm_err *e)
 {
   const char *want = I->variant[0] ? I->variant : I->opt.scheme;
@@ -88,19 +122,9 @@ static int comp_alloc(dm_integrator *I, dm_err *e)
   dm_integ_opts o = I->opt;
   size_t i, n = I->n, s;
   int st;
-  if (!want[0]) {
-    want = I->opt.order == 4 ? "yoshida4" : I->opt.order == 6 ? "kahanli6"
-         : I->opt.order == 8 ? "kahanli8" : NULL;
-    if (want == NULL)
-      return dm_err_set(e, DM_EINVAL, "composition: order = %d not available (4, 6 or 8)",
-                        I->opt.order);
-  }
-  for (i = 0; i < sizeof schemes / sizeof schemes[0]; i++)
-    if (strcmp(want, schemes[i].name) == 0)
-      sc = &schemes[i];
-  if (sc == NULL)
-    return dm_err_set(e, DM_ENOTFOUND, "composition: unknown scheme '%s' (known: yoshida4, "
-                      "yoshida6, kahanli6, mclachlan8, kahanli8)", want);
+  dm_err le;
+  if ((sc = find_scheme(want, I->opt.order, &le)) == NULL)
+    return dm_err_set(e, le.status, "%s", le.msg);
   if (strcmp(I->opt.base, "trapezoid") != 0 && strcmp(I->opt.base, "midpoint") != 0)
     return dm_err_set(e, DM_EINVAL, "composition: base must be 'trapezoid' or 'midpoint' (got '%s')",
                       I->opt.base);

@@ -105,6 +105,12 @@ int dm_prk_constr_finish(dm_prk *P, double h, const double *q0, const double *p0
 int dm_prk_project_momentum(dm_prk *P, const double *q1, const double *G1,
                             double *p1, const double *vguess, dm_err *e);
 
+/* composition.c: the coefficients g[0 .. *s) (at most 17) of a composition
+ * scheme by name, or for "" the default scheme of the order (4, 6, 8);
+ * *order_out its order.  DM_ENOTFOUND / DM_EINVAL with a message. */
+int dm_composition_coeffs(const char *scheme, int order, double *g, size_t *s,
+                          int *order_out, dm_err *e);
+
 /* verlet.c */
 int dm_prk_verlet_setup(dm_prk *P, dm_err *e);
 int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,

@@ -14,7 +14,8 @@
 #include <string.h>
 
 extern const dm_integrator_type dm_integ_midpoint, dm_integ_gauss, dm_integ_trapezoid,
-  dm_integ_lobatto, dm_integ_prk, dm_integ_composition, dm_integ_rk4, dm_integ_gsl;
+  dm_integ_lobatto, dm_integ_prk, dm_integ_composition, dm_integ_rk4, dm_integ_gsl,
+  dm_integ_adapt, dm_integ_sem;
 
 static const dm_integrator_type *const builtin[] = {
   &dm_integ_midpoint,
@@ -24,7 +25,9 @@ static const dm_integrator_type *const builtin[] = {
   &dm_integ_prk,
   &dm_integ_composition,
   &dm_integ_rk4,
-  &dm_integ_gsl
+  &dm_integ_gsl,
+  &dm_integ_adapt,
+  &dm_integ_sem
 };
 #define NBUILTIN (sizeof builtin / sizeof builtin[0])
 

@@ -60,9 +60,11 @@ void dm_linteg_pushstate(lua_State *L, const dm_linteg *li, double t, const doub
                          const double *p, const double *v);
 /* Parse integrator options from the table at idx (skipping the keys in
  * `skip`, a NULL-ended list) into opt, *method (anchored in the table), *h
- * (NAN when absent) and, for method "prk", the user tableau: pushes one
- * value, a userdata owning that tableau (or nil), so nothing leaks when a
- * later check raises; opt->tableau points into it.  Options are mapped by
+ * (NAN when absent) and, for method "prk", the user tableau, and with the
+ * option adapt the monitor of a time transformation (*method becomes
+ * "adapt:<method>"): pushes one value, a table owning them, so nothing
+ * leaks when a later check raises; opt->tableau, opt->monitor point into
+ * it.  Options are mapped by
  * name through dm_integ_options; each must apply to the method, which must
  * apply to sys (its kind picks the family).  Raises naming `fname`. */
 void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const *skip,
@@ -72,6 +74,12 @@ void dm_linteg_push_methods(lua_State *L, const char *kind);
 
 /* The tableau box class (l_integ_opts.c). */
 void dm_linteg_open_opts(lua_State *L);
+/* The option adapt of the table at idx (l_integ_adapt.c): 0 when absent or
+ * false; else sets opt->monitor (its owner stored as own.monitor, own a
+ * table index) or opt->power and returns 1.  Raises naming fname. */
+int dm_linteg_parse_adapt(lua_State *L, int idx, const char *fname, const dm_system *sys,
+                          dm_integ_opts *opt, int own);
+void dm_linteg_open_adapt(lua_State *L);
 
 /* Lua functions defined in l_integ_run.c / l_integ_diag.c. */
 int dm_linteg_run(lua_State *L);

@@ -155,6 +155,8 @@ void dm_linteg_push_methods(lua_State *L, const char *kind)
     luaL_addstring(&b, t->name);
     if (strcmp(t->name, "gsl") == 0)
       luaL_addstring(&b, ":<stepper>");
+    if (strcmp(t->name, "adapt") == 0)
+      luaL_addstring(&b, ":<method>");
     for (a = t->names; a != NULL && *a != NULL; a++) {
       luaL_addstring(&b, ", ");
       luaL_addstring(&b, *a);
@@ -181,6 +183,7 @@ static void all_options(lua_State *L, const char *const *skip)
     luaL_addstring(&b, ", ");
     luaL_addstring(&b, d->name);
   }
+  luaL_addstring(&b, ", adapt");
   for (; skip != NULL && *skip != NULL; skip++) {
     luaL_addstring(&b, ", ");
     luaL_addstring(&b, *skip);
@@ -238,7 +241,8 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
   while (lua_next(L, idx) != 0) {
     const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
     const dm_option_desc *d;
-    if (key != NULL && (strcmp(key, "method") == 0 || in_list(skip, key))) {
+    if (key != NULL && (strcmp(key, "method") == 0 || strcmp(key, "adapt") == 0
+                        || in_list(skip, key))) {
       lua_pop(L, 1);
       continue;
     }
@@ -273,16 +277,24 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
     }
     lua_pop(L, 1);
   }
+  /* what opt points to (a tableau, a monitor) is owned by one table */
+  lua_createtable(L, 0, 3);
+  int own = lua_gettop(L);
   /* families with a user tableau among other methods (the reduced ones)
    * read it only when given; "prk" itself requires it */
   lua_getfield(L, idx, "tableau");
   given = !lua_isnil(L, -1);
   lua_pop(L, 1);
+  opt->tableau = NULL;
   if (in_list(type->options, "tableau") && (given || strcmp(type->name, "prk") == 0)) {
     opt->tableau = parse_tableau(L, idx, fname);
-  } else {
-    lua_pushnil(L);
-    opt->tableau = NULL;
+    lua_setfield(L, own, "tableau");
+  }
+  /* a time transformation of the method: "adapt:<method>" */
+  if (dm_linteg_parse_adapt(L, idx, fname, sys, opt, own)) {
+    lua_pushfstring(L, "adapt:%s", *method);
+    *method = lua_tostring(L, -1);
+    lua_setfield(L, own, "method");
   }
 }
 
@@ -296,8 +308,9 @@ void dm_linteg_doc_options(lua_State *L)
   const dm_option_desc *d;
   keys[k++] = "method";
   keys[k++] = "tableau";
-  for (d = dm_integ_options; d->name != NULL && k + 1 < sizeof keys / sizeof keys[0]; d++)
+  for (d = dm_integ_options; d->name != NULL && k + 2 < sizeof keys / sizeof keys[0]; d++)
     keys[k++] = d->name;
+  keys[k++] = "adapt";
   keys[k] = NULL;
   dm_doc_options(L, "dm.integrator", keys);
   dm_linteg_doc_run(L);
