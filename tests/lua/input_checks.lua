@@ -78,6 +78,19 @@ local full = dm.integrator(dm.system{name = "planar orbit", coords = {"r"},
 T.like(err(red.reconstruct, red, full), "%(reconstruct takes a run of the reduced system%)",
        "a trajectory of the full system's name: says which run is needed")
 
+-- a diverging run ends early with a message, keeping what it computed
+local stiff = dm.system{name = "stiff quartic", coords = {"q"},
+  L = function(q, v) return 0.5 * v.q^2 - 1e12 * q.q^4 / 4 end}
+local gs = dm.integrator(stiff, {method = "gauss", h = 100})
+local tr, msg = gs:run({q = {1}, v = {0}}, {steps = 20, max_energy_error = 1e3})
+T.ok(#tr == 2 and msg and msg:find("^run: the energy error |E %- E0| = 5e%+27 exceeds " ..
+     "max_energy_error = 1000 x max%(1, |E0|%) at step 1 of 20 %(t = 100%): the run diverged"),
+     "energy runaway (2.5e11 -> 5e27 in one step) stops the run: " .. tostring(msg))
+T.is(tr:meta().status ~= 0 and tr:energy()[1], 2.5e11, "the samples before are kept, status set")
+tr, msg = gs:run({q = {1}, v = {0}}, {steps = 200})
+T.ok(msg and msg:find("the energy became non%-finite at step %d+ of 200") and #tr < 200,
+     "without a threshold the same run stops when the energy overflows: " .. tostring(msg))
+
 -- branches on symbolic values that Lua does not let dmech see
 T.like(err(dm.system, {coords = {"x", "y"}, L = function(q, v)
          if q.x < q.y then return v.x^2 end return v.y^2 end}),
