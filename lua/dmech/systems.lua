@@ -47,6 +47,10 @@ return function(dm, C)
       if type(v) ~= "number" then
         error(("dm.systems.%s: parameter %s must be a number, got %s"):format(fname, d[1], type(v)), 3)
       end
+      if v ~= v or v == math.huge or v == -math.huge then
+        error(("dm.systems.%s: parameter %s must be finite, got %s"):format(fname, d[1],
+          v ~= v and "nan" or v > 0 and "inf" or "-inf"), 3)
+      end
       list[#list + 1] = {d[1], v}
     end
     for _, k in ipairs(extra) do ex[k] = opts[k] end

@@ -304,6 +304,7 @@ static int pmain(lua_State *L)
     unsetenv("DMECH_PATH");
   }
   luaL_openlibs(L);
+  dm_lua_number_tostring(L);           /* NaN prints "nan", never "-nan" */
   createargtable(L, argv, argc, script);
   lua_gc(L, LUA_GCGEN, 0, 0);
   if (open_dmech(L) != LUA_OK)

@@ -578,6 +578,18 @@ dm_traj *dm_traj_load(const char *path, dm_err *e)
     dm_err_set(e, DM_EIO, "cannot open '%.200s': %s", r.path, strerror(errno));
     return NULL;
   }
+  {
+    /* a device never ends (/dev/zero, /dev/full: one endless line of NUL
+     * bytes); a FIFO (a pipe from another program) is fine */
+    struct stat sb;
+    if (fstat(fileno(r.f), &sb) == 0 && !S_ISREG(sb.st_mode) && !S_ISFIFO(sb.st_mode)) {
+      dm_err_set(e, DM_EINVAL, "cannot read '%.200s': it is %s, not a file", r.path,
+                 S_ISDIR(sb.st_mode) ? "a directory" : S_ISCHR(sb.st_mode)
+                 ? "a character device" : "a special file");
+      fclose(r.f);
+      return NULL;
+    }
+  }
   while ((got = next_line(&r)) > 0 && r.line[0] == '#')
     if ((st = read_comment(&r, &pr)) != DM_OK)
       break;

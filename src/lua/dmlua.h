@@ -101,8 +101,23 @@ void dm_lua_run_check_flags(lua_State *L, int opts);
 int dm_argexpected(lua_State *L, int arg, const char *expected,
                    const char *actual);
 
+/* Give numbers a __tostring that prints NaN as "nan" (print, tostring,
+ * string.format "%s" and every message built with them; Lua's own
+ * conversion says "-nan" for 0/0 on x86-64).  A process-wide setting of
+ * the state: the dmech program and dmech-fuzz call it, a host loading the
+ * module keeps Lua's behaviour unless it calls it too. */
+void dm_lua_number_tostring(lua_State *L);
+
+/* luaL_checkoption that does not turn a number into a name ("-nan"). */
+int dm_checkoption(lua_State *L, int arg, const char *def, const char *const lst[]);
+
+/* luaL_tolstring for messages: NaN and infinities print as "nan", "inf",
+ * "-inf" (Lua's own conversion says "-nan" for the NaN of 0/0 on x86). */
+const char *dm_tolstring(lua_State *L, int idx, size_t *len);
+
 /* luaL_checkstring for strings that go to C as C strings (file names,
- * names, metadata): one holding a NUL byte is refused, never truncated. */
+ * names, metadata): a string, not a number turned into one, and one
+ * holding a NUL byte is refused, never truncated. */
 const char *dm_checkcstring(lua_State *L, int arg);
 /* lua_tostring with the same check on a value that is not an argument;
  * `what` starts the message "<what>: NUL byte at position k of "...""). */

@@ -85,8 +85,11 @@ static void check_opts(lua_State *L, int t, const char *fname, const char *const
           luaL_addstring(&b, ", ");
       }
       luaL_pushresult(&b);
-      luaL_error(L, "%s: unknown option '%s' (options: %s)", fname,
-                 luaL_tolstring(L, -3, NULL), lua_tostring(L, -2));
+      {
+        const char *list = lua_tostring(L, -1);      /* order matters: */
+        const char *bad = dm_tolstring(L, -3, NULL);  /* this one pushes */
+        luaL_error(L, "%s: unknown option '%s' (options: %s)", fname, bad, list);
+      }
     }
     lua_pop(L, 1);
   }

@@ -75,7 +75,7 @@ static int c_newindex(lua_State *L)
   dm_lcochain *c = dm_checkcochain(L, 1);
   int i;
   if (lua_type(L, 2) != LUA_TNUMBER)
-    return luaL_error(L, "cannot set field '%s' of a cochain", luaL_tolstring(L, 2, NULL));
+    return luaL_error(L, "cannot set field '%s' of a cochain", dm_tolstring(L, 2, NULL));
   i = index_arg(L, c, 2);
   c->v[i] = luaL_checknumber(L, 3);
   return 0;

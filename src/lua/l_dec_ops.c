@@ -103,7 +103,7 @@ static int weights_opt(lua_State *L, int arg, const char *fname)
 
 static int l_load(lua_State *L)
 {
-  const char *path = luaL_checkstring(L, 1);
+  const char *path = dm_checkcstring(L, 1);
   dm_dec_complex *K;
   dm_dec_geom *G;
   dm_err e;
@@ -115,7 +115,7 @@ static int l_load(lua_State *L)
 static int m_save(lua_State *L)
 {
   dm_lmesh *M = dm_checkmesh(L, 1);
-  const char *path = luaL_checkstring(L, 2);
+  const char *path = dm_checkcstring(L, 2);
   dm_err e;
   if (dm_dec_write(path, M->K, M->G, &e) != DM_OK)
     return dm_lua_fail(L, "mesh:save", e.status, &e);

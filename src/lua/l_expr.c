@@ -266,7 +266,7 @@ static int l_select(lua_State *L)
 /* dm.apply(name, args...): a function by name, for generated code. */
 static int l_apply(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   int n = lua_gettop(L) - 1;
   dm_expr args[3] = { DM_EXPR_NONE, DM_EXPR_NONE, DM_EXPR_NONE };
   for (int i = 0; i < n && i < 3; i++)
@@ -281,14 +281,14 @@ static int l_apply(lua_State *L)
 
 static int l_sym(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   dm_lua_pushexpr(L, dm_expr_sym(dm_lua_exprctx(L), name));
   return 1;
 }
 
 static int l_param(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   dm_lua_pushexpr(L, dm_expr_param(dm_lua_exprctx(L), name));
   return 1;
 }
@@ -296,7 +296,7 @@ static int l_param(lua_State *L)
 /* dm.syms "r theta z" -> r, theta, z */
 static int l_syms(lua_State *L)
 {
-  const char *s = luaL_checkstring(L, 1);
+  const char *s = dm_checkcstring(L, 1);
   dm_expr_ctx *ctx = dm_lua_exprctx(L);
   int n = 0;
   while (*s) {
@@ -377,7 +377,7 @@ static int symvec_index(lua_State *L)
     luaL_buffinit(L, &b);
     for (lua_Integer i = 1; i <= n; i++) {
       lua_rawgeti(L, data, i);
-      luaL_tolstring(L, -1, NULL);
+      dm_tolstring(L, -1, NULL);
       lua_remove(L, -2);
       luaL_addvalue(&b);
       if (i < n)
@@ -425,7 +425,7 @@ static int symvec_tostring(lua_State *L)
   lua_Integer n = (lua_Integer)lua_rawlen(L, data);
   for (lua_Integer i = 1; i <= n; i++) {
     lua_rawgeti(L, data, i);
-    luaL_tolstring(L, -1, NULL);
+    dm_tolstring(L, -1, NULL);
     lua_remove(L, -2);
     luaL_addvalue(&b);
     if (i < n)
@@ -538,7 +538,7 @@ static size_t symvec_names(lua_State *L, int arg, const char *label,
 /* dm.symvec(label, names | n [, fmt]) */
 static int l_symvec(lua_State *L)
 {
-  const char *label = luaL_checkstring(L, 1);
+  const char *label = dm_checkcstring(L, 1);
   const char *fmt = checkfmt(L, 3);
   lua_settop(L, 3);
   const char **names;
@@ -550,7 +550,7 @@ static int l_symvec(lua_State *L)
 /* dm.paramvec(label, names) */
 static int l_paramvec(lua_State *L)
 {
-  const char *label = luaL_checkstring(L, 1);
+  const char *label = dm_checkcstring(L, 1);
   lua_settop(L, 2);
   const char **names;
   size_t n = symvec_names(L, 2, label, &names);
@@ -693,7 +693,7 @@ int dm_lua_native_mode(lua_State *L)
     mode = s ? dm_native_mode_parse(s) : -1;
     if (mode < 0)
       luaL_error(L, "dm.config.native must be \"auto\", \"wait\", \"always\" or "
-                 "\"never\" (got %s)", luaL_tolstring(L, -1, NULL));
+                 "\"never\" (got %s)", dm_tolstring(L, -1, NULL));
   }
   lua_settop(L, top);
   return mode;

@@ -121,6 +121,8 @@ static dm_expr *vars_arg(lua_State *L, int idx, size_t nroot,
       lua_geti(L, idx, (lua_Integer)i + 1);
     if (lua_type(L, -1) == LUA_TSTRING) {
       v[i] = resolve_name(L, nroot, roots, lua_tostring(L, -1));
+      if (v[i] == DM_EXPR_NONE)        /* a bad name: raise now, or the */
+        dm_lua_ctx_raise(L, ctx);      /* context's error stays pending */
     } else {
       dm_expr *u = luaL_testudata(L, -1, DM_EXPR_MT);
       int op = u ? dm_expr_kind(ctx, *u) : -1;
@@ -240,12 +242,16 @@ static void bindings(lua_State *L, int idx, dm_expr e, binding *b)
   while (lua_next(L, idx) != 0) {
     int isnum = lua_type(L, -1) == LUA_TNUMBER;
     dm_expr to = DM_EXPR_NONE;
-    if (b->nums && !isnum)
+    if (b->nums && !isnum) {
+      const char *tn = luaL_typename(L, -1);   /* before dm_tolstring pushes */
       luaL_error(L, "eval: the value of %s is a %s, number expected",
-                 luaL_tolstring(L, -2, NULL), luaL_typename(L, -2));
-    if (!b->nums && (to = dm_lua_toexpr(L, -1)) == DM_EXPR_NONE)
+                 dm_tolstring(L, -2, NULL), tn);
+    }
+    if (!b->nums && (to = dm_lua_toexpr(L, -1)) == DM_EXPR_NONE) {
+      const char *tn = luaL_typename(L, -1);
       luaL_error(L, "subs: the value of %s is a %s, expression or number "
-                 "expected", luaL_tolstring(L, -2, NULL), luaL_typename(L, -2));
+                 "expected", dm_tolstring(L, -2, NULL), tn);
+    }
     if (lua_type(L, -2) == LUA_TSTRING) {
       const char *name = lua_tostring(L, -2);
       for (long i = 0; i < nfv; i++)

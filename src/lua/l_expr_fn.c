@@ -88,9 +88,11 @@ static dm_expr *inputs_arg(lua_State *L, int t, size_t nout, const dm_expr *out,
     else
       lua_geti(L, idx, (lua_Integer)i + 1);
     dm_expr *u = luaL_testudata(L, -1, DM_EXPR_MT);
-    if (lua_type(L, -1) == LUA_TSTRING)
+    if (lua_type(L, -1) == LUA_TSTRING) {
       v[i] = by_name(ctx, nout, out, lua_tostring(L, -1), 0);
-    else if (u && (dm_expr_kind(ctx, *u) == DM_EXPR_SYM ||
+      if (v[i] == DM_EXPR_NONE)               /* a bad name: raise now */
+        dm_lua_ctx_raise(L, ctx);
+    } else if (u && (dm_expr_kind(ctx, *u) == DM_EXPR_SYM ||
                    dm_expr_kind(ctx, *u) == DM_EXPR_PARAM))
       v[i] = *u;
     else
@@ -148,6 +150,8 @@ static dm_expr *params_arg(lua_State *L, int t, size_t nout, const dm_expr *out,
     f->par[i] = lua_tonumber(L, -1);
     lua_pop(L, 1);
     v[i] = by_name(ctx, nout, out, f->pnames[i], 1);
+    if (v[i] == DM_EXPR_NONE)
+      dm_lua_ctx_raise(L, ctx);
   }
   return v;
 }
@@ -292,7 +296,7 @@ static int fn_batch(lua_State *L)
 
 static long param_index(lua_State *L, lfn *f, int arg)
 {
-  const char *name = luaL_checkstring(L, arg);
+  const char *name = dm_checkcstring(L, arg);
   for (size_t i = 0; i < f->npar; i++)
     if (strcmp(f->pnames[i], name) == 0)
       return (long)i;

@@ -62,7 +62,7 @@ static int l_tableau(lua_State *L)
 {
   static const char *const kinds[] = {"gauss", "lobatto", "galerkin", "midpoint", "trapezoid",
                                       NULL};
-  int kind = luaL_checkoption(L, 1, NULL, kinds);
+  int kind = dm_checkoption(L, 1, NULL, kinds);
   dm_tableau **box = push_box(L);
   double c[DM_TABLEAU_SMAX];
   lua_Integer s = 0;

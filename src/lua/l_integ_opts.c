@@ -250,7 +250,7 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
     if (d == NULL && !(key && strcmp(key, "tableau") == 0)) {
       all_options(L, skip);
       const char *list = lua_tostring(L, -1);
-      luaL_error(L, "%s: unknown option %s (options: %s)", fname, luaL_tolstring(L, -3, NULL),
+      luaL_error(L, "%s: unknown option %s (options: %s)", fname, dm_tolstring(L, -3, NULL),
                  list);
     }
     if (!in_list(type->options, key)) {
@@ -272,7 +272,7 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
         *h = lua_tonumber(L, -1);
         if (*h == 0.0 || !isfinite(*h))
           luaL_error(L, "%s: option 'h' must be a finite non-zero number, got %s", fname,
-                     luaL_tolstring(L, -1, NULL));
+                     dm_tolstring(L, -1, NULL));
       }
     }
     lua_pop(L, 1);

@@ -80,7 +80,7 @@ static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, unsigned ch
       if (lua_rawgeti(L, -1, (lua_Integer)i) != LUA_TSTRING ||
           (c = dm_lua_system_coord(ls, lua_tostring(L, -1))) < 0)
         luaL_error(L, "run: momentum[%d] must name a coordinate of '%s', got %s", (int)i,
-                   ls->sys.name, luaL_tolstring(L, -1, NULL));
+                   ls->sys.name, dm_tolstring(L, -1, NULL));
       mom[c] = 1;
       lua_pop(L, 1);
     }
@@ -102,7 +102,7 @@ static void check_keys(lua_State *L, int o)
     if (key == NULL || *k == NULL)
       luaL_error(L, "run: unknown option %s (options: steps, t, every, progress, energy, "
                  "momentum, h, chunk, max_energy_error, strict, warn, sink, sink_every)",
-                 luaL_tolstring(L, -2, NULL));
+                 dm_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
 }
@@ -194,7 +194,7 @@ static int sink_call(void *ctx, const dm_traj *tr, dm_err *e)
   lua_pushvalue(L, sc->fn);
   lua_pushvalue(L, sc->traj);
   if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
-    dm_err_set(e, DM_EFAILED, "%s", luaL_tolstring(L, -1, NULL));
+    dm_err_set(e, DM_EFAILED, "%s", dm_tolstring(L, -1, NULL));
     lua_pop(L, 2);
     return DM_EFAILED;
   }

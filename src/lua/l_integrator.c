@@ -238,7 +238,7 @@ void dm_lua_readstate(lua_State *L, dm_lsystem *ls, dm_integrator *I, int idx,
   if (lua_getfield(L, idx, "t") != LUA_TNIL) {
     if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(lua_tonumber(L, -1)))
       luaL_error(L, "%s: state.t must be a finite number, got %s", fname,
-                 luaL_tolstring(L, -1, NULL));
+                 dm_tolstring(L, -1, NULL));
     s->t = lua_tonumber(L, -1);
   }
   lua_pop(L, 1);
@@ -492,7 +492,7 @@ static int flag_field(lua_State *L, const dm_linteg *li, const char *k)
 
 static int integ_index(lua_State *L)
 {
-  const char *k = luaL_checkstring(L, 2);
+  const char *k = dm_checkcstring(L, 2);
   if (lua_getfield(L, lua_upvalueindex(1), k) != LUA_TNIL)
     return 1;
   dm_linteg *li = dm_linteg_check(L, 1);
@@ -529,14 +529,14 @@ static int integ_index(lua_State *L)
 static int integ_newindex(lua_State *L)
 {
   dm_linteg *li = dm_linteg_check(L, 1);
-  const char *k = luaL_checkstring(L, 2);
+  const char *k = dm_checkcstring(L, 2);
   double h;
   if (strcmp(k, "h") != 0)
     return luaL_error(L, "integrator field '%s' is read-only (only h can be set)", k);
   h = lua_tonumber(L, 3);
   if (lua_type(L, 3) != LUA_TNUMBER || h == 0.0 || !isfinite(h))
     return luaL_error(L, "integ.h must be a finite non-zero number, got %s",
-                      luaL_tolstring(L, 3, NULL));
+                      dm_tolstring(L, 3, NULL));
   li->h = h;
   li->opt.h = h;
   return 0;

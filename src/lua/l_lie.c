@@ -604,7 +604,7 @@ static int group_fields(lua_State *L)
   const dm_lie_group *G = dm_lua_checkgroup(L, 1);
   const char *k = lua_tostring(L, 2);
   if (k == NULL)
-    return luaL_error(L, "a Lie group has no field %s", luaL_tolstring(L, 2, NULL));
+    return luaL_error(L, "a Lie group has no field %s", dm_tolstring(L, 2, NULL));
   if (strcmp(k, "name") == 0)
     lua_pushstring(L, G->name);
   else if (strcmp(k, "dim") == 0)
@@ -705,7 +705,7 @@ static int l_product(lua_State *L)
 
 static int l_group(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   dm_err e;
   dm_lie_group **slot = dm_lua_newgroup(L);
   if ((*slot = dm_lie_group_parse(name, &e)) == NULL)

@@ -392,7 +392,7 @@ static int e_index(lua_State *L)
   if (lua_isinteger(L, 2))
     return index_int(L, a, lua_tointeger(L, 2));
   if ((k = lua_tostring(L, 2)) == NULL)
-    return luaL_error(L, "%s element: no field %s", G->name, luaL_tolstring(L, 2, NULL));
+    return luaL_error(L, "%s element: no field %s", G->name, dm_tolstring(L, 2, NULL));
   if (luaL_getmetafield(L, 1, "__methods") != LUA_TNIL) {
     lua_pushvalue(L, 2);
     if (lua_rawget(L, -2) != LUA_TNIL)

@@ -266,7 +266,7 @@ static int gp_fmt(lua_State *L)
 
 static int gp_style_ok(lua_State *L)
 {
-  lua_pushboolean(L, dm_gp_valid_style(luaL_checkstring(L, 1)));
+  lua_pushboolean(L, dm_gp_valid_style(dm_checkcstring(L, 1)));
   return 1;
 }
 
@@ -274,7 +274,7 @@ static int gp_style_ok(lua_State *L)
  * of one length (tables are converted in place, so Lua owns all memory). */
 static int gp_data(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   int k = lua_gettop(L) - 1, i;
   const double *cols[8];
   size_t n = 0;

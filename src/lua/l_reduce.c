@@ -157,7 +157,7 @@ static void check_keys(lua_State *L, int o, const char *const *keys, const char 
         ok = strcmp(*k, lua_tostring(L, -2)) == 0;
     if (!ok) {
       lua_pop(L, 1);
-      luaL_error(L, "%s: unknown option %s", fname, luaL_tolstring(L, -1, NULL));
+      luaL_error(L, "%s: unknown option %s", fname, dm_tolstring(L, -1, NULL));
     }
     lua_pop(L, 1);
   }
@@ -437,7 +437,7 @@ static int r_index(lua_State *L)
   dm_routh *red = u->red;
   const dm_routh_exprs *x = dm_routh_exprs_get(red);
   const dm_system *rs = dm_routh_system(red), *fs = dm_routh_full(red);
-  const char *k = luaL_checkstring(L, 2);
+  const char *k = dm_checkcstring(L, 2);
   if (lua_getfield(L, lua_upvalueindex(1), k) != LUA_TNIL)     /* methods */
     return 1;
   lua_pop(L, 1);

@@ -217,7 +217,7 @@ static int d_dtheta(lua_State *L)
 static int ldr_index(lua_State *L)
 {
   ldr *D = luaL_checkudata(L, 1, DR_MT);
-  const char *k = luaL_checkstring(L, 2);
+  const char *k = dm_checkcstring(L, 2);
   if (lua_getfield(L, lua_upvalueindex(1), k) != LUA_TNIL)
     return 1;
   if (strcmp(k, "h") == 0)
@@ -277,7 +277,7 @@ int dm_lrouth_discrete(lua_State *L)
       k++;
     if (*k == NULL)
       return luaL_error(L, "discrete: unknown option %s (options: method, stages, h)",
-                        luaL_tolstring(L, -2, NULL));
+                        dm_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
   method = dm_optstringfield(L, 2, "method", "midpoint");

@@ -140,7 +140,7 @@ const char *dm_lsystem_names(lua_State *L, const char *const *names, size_t n)
 
 long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg)
 {
-  const char *name = luaL_checkstring(L, arg);
+  const char *name = dm_checkcstring(L, arg);
   long i = dm_lua_system_param(ls, name);
   if (i < 0)
     luaL_error(L, "no parameter '%s' in system '%s' (parameters: %s)", name, ls->sys.name,
@@ -150,7 +150,7 @@ long dm_lsystem_checkparam(lua_State *L, const dm_lsystem *ls, int arg)
 
 long dm_lsystem_checkcoord(lua_State *L, const dm_lsystem *ls, int arg)
 {
-  const char *name = luaL_checkstring(L, arg);
+  const char *name = dm_checkcstring(L, arg);
   long i = dm_lua_system_coord(ls, name);
   if (i < 0)
     luaL_error(L, "no coordinate '%s' in system '%s' (coordinates: %s)", name, ls->sys.name,
@@ -233,7 +233,7 @@ void dm_lua_system_readvec(lua_State *L, const dm_lsystem *ls, int idx,
   while (lua_next(L, idx) != 0) {
     if (lua_type(L, -2) != LUA_TSTRING || (dm_lua_system_coord(ls, lua_tostring(L, -2)) < 0 &&
                                           find_group(ls, lua_tostring(L, -2)) < 0)) {
-      const char *key = luaL_tolstring(L, -2, NULL);
+      const char *key = dm_tolstring(L, -2, NULL);
       const char *known = dm_lsystem_names(L, ls->sys.coords, n);
       luaL_error(L, "%s: unknown coordinate %s (coordinates: %s)", what, key, known);
     }
@@ -301,7 +301,7 @@ static int is_ident(const char *s)
  * dm.system's coords (alone or in the list). */
 static int l_coords(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
+  const char *name = dm_checkcstring(L, 1);
   lua_Integer n = luaL_checkinteger(L, 2);
   if (!is_ident(name))
     luaL_argerror(L, 1, "a name (letters, digits, _) expected");
@@ -398,7 +398,7 @@ static const char **read_coords(lua_State *L, int t, dm_lsystem *ls, size_t *n)
     }
     if (lua_type(L, -1) != LUA_TSTRING || !is_ident(lua_tostring(L, -1)))
       luaL_error(L, "dm.system: coordinate %d must be a name (letters, digits, _) or "
-                 "dm.coords(name, n), got %s", (int)i + 1, luaL_tolstring(L, -1, NULL));
+                 "dm.coords(name, n), got %s", (int)i + 1, dm_tolstring(L, -1, NULL));
     names[k++] = lua_tostring(L, -1);
     lua_pop(L, 1);
   }
@@ -595,7 +595,7 @@ static void check_fields(lua_State *L, int t)
         ;
     if (lua_type(L, -1) != LUA_TSTRING || known[i] == NULL) {
       int str = lua_type(L, -1) == LUA_TSTRING;
-      const char *key = luaL_tolstring(L, -1, NULL);
+      const char *key = dm_tolstring(L, -1, NULL);
       luaL_error(L, "dm.system: unknown field %s%s%s (fields: name, coords, params, L, "
                  "force, constraints, native)", str ? "'" : "[", key, str ? "'" : "]");
     }

@@ -180,7 +180,7 @@ static int exprlist_tostring(lua_State *L)
   luaL_addchar(&b, '{');
   for (lua_Integer i = 1; i <= n; i++) {
     lua_rawgeti(L, 1, i);
-    luaL_tolstring(L, -1, NULL);
+    dm_tolstring(L, -1, NULL);
     lua_remove(L, -2);
     luaL_addvalue(&b);
     if (i < n)
@@ -279,7 +279,7 @@ static int system_index(lua_State *L)
 {
   dm_lsystem *ls = luaL_checkudata(L, 1, DM_SYSTEM_MT);
   const char *k;
-  if (lua_getfield(L, lua_upvalueindex(1), luaL_checkstring(L, 2)) != LUA_TNIL)
+  if (lua_getfield(L, lua_upvalueindex(1), dm_checkcstring(L, 2)) != LUA_TNIL)
     return 1;
   k = lua_tostring(L, 2);
   if (ls->sys.lagrangian == NULL)
@@ -398,7 +398,7 @@ static int params_newindex(lua_State *L)
 static int params_next(lua_State *L)
 {
   dm_lsystem *ls = proxy_sys(L);
-  long i = lua_isnil(L, 2) ? 0 : dm_lua_system_param(ls, luaL_checkstring(L, 2)) + 1;
+  long i = lua_isnil(L, 2) ? 0 : dm_lua_system_param(ls, dm_checkcstring(L, 2)) + 1;
   if (i < 0 || (size_t)i >= ls->npar)
     return 0;
   lua_pushstring(L, ls->sys.params[i]);

@@ -255,7 +255,7 @@ static int cols_index(lua_State *L)
   }
   if (i == n) {
     const char *q = lua_type(L, 2) == LUA_TSTRING ? "'" : "";
-    const char *key = luaL_tolstring(L, 2, NULL);
+    const char *key = dm_tolstring(L, 2, NULL);
     luaL_Buffer b;
     luaL_buffinit(L, &b);
     lua_pushfstring(L, "no coordinate %s%s%s (coordinates: ", q, key, q);
@@ -453,7 +453,7 @@ static int t_names(lua_State *L)
   static const char *const kinds[] = {"t", "q", "p", "v", "diag", "derived",
                                       "data", "all", NULL};
   dm_traj *tr = dm_checktraj(L, 1);
-  int want = luaL_checkoption(L, 2, "all", kinds);
+  int want = dm_checkoption(L, 2, "all", kinds);
   size_t j, nc = dm_traj_ncols(tr);
   lua_Integer k = 0;
   lua_createtable(L, (int)nc, 0);

@@ -21,7 +21,7 @@ int dm_ltraj_setmeta(lua_State *L, dm_traj *tr, const char *key, int arg, dm_err
   if (t == LUA_TSTRING)
     return dm_traj_meta_set(tr, key, dm_tocstring(L, arg, "metadata value"), e);
   if (t == LUA_TBOOLEAN) {
-    int st = dm_traj_meta_set(tr, key, luaL_tolstring(L, arg, NULL), e);
+    int st = dm_traj_meta_set(tr, key, dm_tolstring(L, arg, NULL), e);
     lua_pop(L, 1);
     return st;
   }

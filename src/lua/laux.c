@@ -22,10 +22,55 @@ int dm_argexpected(lua_State *L, int arg, const char *expected,
   return luaL_argerror(L, arg, msg);
 }
 
+/* __tostring of numbers: Lua's own conversion, except "nan" for every NaN
+ * (the NaN of 0/0 prints "-nan" on x86-64). */
+static int number_tostring(lua_State *L)
+{
+  if (lua_type(L, 1) == LUA_TNUMBER && !lua_isinteger(L, 1) && isnan(lua_tonumber(L, 1))) {
+    lua_pushliteral(L, "nan");
+    return 1;
+  }
+  lua_pushvalue(L, 1);
+  lua_tolstring(L, -1, NULL);      /* the raw conversion: no metamethod */
+  return 1;
+}
+
+void dm_lua_number_tostring(lua_State *L)
+{
+  lua_pushinteger(L, 0);
+  if (!lua_getmetatable(L, -1))
+    lua_createtable(L, 0, 1);
+  lua_pushcfunction(L, number_tostring);
+  lua_setfield(L, -2, "__tostring");
+  lua_setmetatable(L, -2);
+  lua_pop(L, 1);
+}
+
+const char *dm_tolstring(lua_State *L, int idx, size_t *len)
+{
+  if (lua_type(L, idx) == LUA_TNUMBER && !lua_isinteger(L, idx)
+      && !isfinite(lua_tonumber(L, idx))) {
+    char buf[DM_NUM_BUFSIZE];
+    dm_num_format(buf, sizeof buf, lua_tonumber(L, idx));
+    return lua_pushlstring(L, buf, len != NULL ? (*len = strlen(buf)) : strlen(buf));
+  }
+  return luaL_tolstring(L, idx, len);
+}
+
+int dm_checkoption(lua_State *L, int arg, const char *def, const char *const lst[])
+{
+  if (lua_type(L, arg) == LUA_TNUMBER)
+    luaL_checktype(L, arg, LUA_TSTRING);
+  return luaL_checkoption(L, arg, def, lst);
+}
+
 const char *dm_checkcstring(lua_State *L, int arg)
 {
   size_t len;
-  const char *s = luaL_checklstring(L, arg, &len);
+  const char *s;
+  if (lua_type(L, arg) != LUA_TSTRING)     /* no number coerced to "-nan" */
+    luaL_checktype(L, arg, LUA_TSTRING);
+  s = lua_tolstring(L, arg, &len);
   if (strlen(s) != len)
     dm_argexpected(L, arg, "string without NUL bytes",
                    lua_pushfstring(L, "a string with a NUL byte at position %d",

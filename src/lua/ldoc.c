@@ -65,9 +65,31 @@ void dm_doc_add(lua_State *L, const char *name, const char *sig,
   lua_pop(L, 2);
 }
 
+/* Lua names a C function that was called without a name (pcall(f, ...), a
+ * tail call) by searching package.loaded, as it finds string.rep.  Each
+ * method ("<kind>:" prefix) is put there under its documented name, so
+ * that errors say "bad argument #2 to 'trajectory:meta'", not "to '?'"
+ * (a key with a colon is never a module name that require would ask for).
+ * Functions of dm and its sub-tables are found through package.loaded
+ * ["dmech"] and ["dmech.<sub>"] (module.c). */
+static void name_methods(lua_State *L, const char *prefix, const dm_reg *regs)
+{
+  size_t n = strlen(prefix);
+  if (n == 0 || prefix[n - 1] != ':')
+    return;
+  luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+  for (; regs->name != NULL; regs++) {
+    lua_pushfstring(L, "%s%s", prefix, regs->name);
+    lua_pushcfunction(L, regs->func);
+    lua_settable(L, -3);
+  }
+  lua_pop(L, 1);
+}
+
 void dm_register(lua_State *L, const char *prefix, const dm_reg *regs)
 {
   luaL_Buffer b;
+  name_methods(L, prefix, regs);
   for (; regs->name != NULL; regs++) {
     lua_pushcfunction(L, regs->func);
     luaL_buffinit(L, &b);
@@ -86,8 +108,20 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
   char prefix[64];
   luaL_newmetatable(L, tname);
   snprintf(prefix, sizeof prefix, "%s:", kind);
-  if (meta != NULL)
+  if (meta != NULL) {
+    const luaL_Reg *m;
     luaL_setfuncs(L, meta, 0);
+    /* a callable object called from C (traj:derive calling an fn) is
+     * named "<kind>()" in errors, as methods are named above */
+    for (m = meta; m->name != NULL; m++)
+      if (strcmp(m->name, "__call") == 0) {
+        luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+        lua_pushfstring(L, "%s()", kind);
+        lua_pushcfunction(L, m->func);
+        lua_settable(L, -3);
+        lua_pop(L, 1);
+      }
+  }
   lua_pushstring(L, kind);
   lua_setfield(L, -2, "__name");
   pushregtable(L, "dmech.classes", "k");
@@ -105,15 +139,6 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
     } else {
       lua_pop(L, 1);
     }
-    /* Lua names a C function that was called without a name (through
-     * pcall, a tail call, a local) by searching package.loaded, as it does
-     * for string.rep: put the methods there so that errors say
-     * "bad argument #2 to 'dmech.trajectory.meta'", not "to '?'". */
-    luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
-    lua_pushfstring(L, "dmech.%s", kind);
-    lua_pushvalue(L, -3);
-    lua_settable(L, -3);
-    lua_pop(L, 1);
     lua_setfield(L, -2, "__methods");   /* for completion and the doc test */
   }
 }
@@ -157,9 +182,9 @@ static int l_docs(lua_State *L)
 
 static int l_doc(lua_State *L)
 {
-  const char *name = luaL_checkstring(L, 1);
-  const char *sig = luaL_checkstring(L, 2);
-  const char *doc = luaL_checkstring(L, 3);
+  const char *name = dm_checkcstring(L, 1);
+  const char *sig = dm_checkcstring(L, 2);
+  const char *doc = dm_checkcstring(L, 3);
   dm_doc_add(L, name, sig, doc, lua_isnoneornil(L, 4) ? 0 : 4);
   return 0;
 }

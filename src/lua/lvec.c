@@ -309,7 +309,7 @@ static int m_newindex(lua_State *L)
   size_t k;
   if (lua_type(L, 2) != LUA_TNUMBER)
     return luaL_error(L, "vec: cannot set field '%s' (only integer indices)",
-                      luaL_tolstring(L, 2, NULL));
+                      dm_tolstring(L, 2, NULL));
   k = checkindex(L, v, 2);
   gsl_vector_set(v, k, luaL_checknumber(L, 3));
   return 0;

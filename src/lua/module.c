@@ -120,6 +120,37 @@ static int return_upvalue(lua_State *L)
   return 1;
 }
 
+/* Lua names a function called without a name (pcall(dm.mesh.grid, 5)) by
+ * searching package.loaded two levels deep: "dmech.vec" is found, but
+ * dm.mesh.grid is a level deeper and was reported as '?'.  Put every
+ * sub-table of functions (dm.mesh, dm.lie, ...) there as "dmech.<name>"
+ * unless that name is taken. */
+static void name_subtables(lua_State *L, int dm)
+{
+  int loaded;
+  lua_getglobal(L, "package");
+  lua_getfield(L, -1, "loaded");
+  loaded = lua_gettop(L);
+  lua_pushnil(L);
+  while (lua_next(L, dm) != 0) {            /* key, value */
+    int plain = lua_type(L, -2) == LUA_TSTRING && lua_type(L, -1) == LUA_TTABLE;
+    if (plain && lua_getmetatable(L, -1)) {  /* a class or proxy: not a module */
+      lua_pop(L, 1);
+      plain = 0;
+    }
+    if (plain) {
+      const char *name = lua_pushfstring(L, "dmech.%s", lua_tostring(L, -2));
+      if (lua_getfield(L, loaded, name) == LUA_TNIL) {
+        lua_pushvalue(L, -3);
+        lua_setfield(L, loaded, name);
+      }
+      lua_pop(L, 2);
+    }
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 2);
+}
+
 int luaopen_dmech(lua_State *L)
 {
   dm_gsl_init();
@@ -149,5 +180,6 @@ int luaopen_dmech(lua_State *L)
   lua_pushcclosure(L, return_upvalue, 1);
   lua_setfield(L, -2, "dmech.core");
   lua_pop(L, 2);
+  name_subtables(L, lua_gettop(L));
   return 1;
 }

@@ -44,7 +44,7 @@ T.like(err(dm.integrator, kep, {method = "gauss", h = -(0/0)}),
        "dm.integrator: option 'h' must be a number, got nan$", "h = -nan: 'nan', never '-nan'")
 local g = dm.integrator(kep, {method = "gauss", h = 0.1})
 T.like(err(g.run, g, {q = {1, 0}, v = {0, 1}}, {steps = 1.5}),
-       "bad argument #3 to 'dmech.integrator.run' %(field 'steps': integer expected, got 1.5%)",
+       "bad argument #3 to 'integrator:run' %(field 'steps': integer expected, got 1.5%)",
        "steps = 1.5 through pcall: the method's name and the value")
 
 -- Routh reduction

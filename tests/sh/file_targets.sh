@@ -107,7 +107,7 @@ local tr = dm.trajectory{t = {0}, coords = {'x'}, q = {x = {1}}}
 print(pcall(tr.save, tr, arg[1] .. '/nul\0.csv'))
 LUA
 out=$("$D" "$T/nul.lua" "$T" 2>&1)
-like "$out" "false.*bad argument #2 to 'dmech.trajectory.save' \(string without NUL bytes expected, got a string with a NUL byte at position" "NUL in a save path"
+like "$out" "false.*bad argument #2 to 'trajectory:save' \(string without NUL bytes expected, got a string with a NUL byte at position" "NUL in a save path"
 test -e "$T/nul"; is $? 1 "... and nothing written at the truncated name"
 out=$("$D" -e "print(pcall(dm.load_trajectory, 'x\0y'))" 2>&1)
 like "$out" "false.*bad argument #1 to 'dmech.load_trajectory' \(string without NUL bytes" "NUL in a load path"
@@ -115,7 +115,7 @@ out=$("$D" -e "print(pcall(dm.trajectory, {t = {0}, coords = {'x'}, q = {x = {1}
 like "$out" "false.*metadata value: NUL byte at position 2" "NUL in a metadata value"
 out=$("$D" -e "local tr = dm.trajectory{t = {0}, coords = {'x'}, q = {x = {1}}}
                print(pcall(tr.meta, tr, 'k\0ey', 'v'))" 2>&1)
-like "$out" "false.*bad argument #2 to 'dmech.trajectory.meta' \(string without NUL bytes" "NUL in a metadata key"
+like "$out" "false.*bad argument #2 to 'trajectory:meta' \(string without NUL bytes" "NUL in a metadata key"
 out=$("$D" -e "print(pcall(dm.plot, { {{0, 1}, {1, 2}}, output = 'a\0.png' }))" 2>&1)
 like "$out" "false.*output: file name without NUL bytes expected, got a NUL byte at position 2" "NUL in a plot file name"
 done_testing
