@@ -182,13 +182,13 @@ static int holo_tostring(lua_State *L)
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "axis") != LUA_TNIL) {
     luaL_addstring(&b, " about ");
-    luaL_addstring(&b, luaL_tolstring(L, -1, NULL));
+    luaL_addstring(&b, dm_tolstring(L, -1, NULL));
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
   if (lua_getfield(L, 1, "body") != LUA_TNIL) {
     luaL_addstring(&b, "; body ");
-    luaL_addstring(&b, luaL_tolstring(L, -1, NULL));
+    luaL_addstring(&b, dm_tolstring(L, -1, NULL));
     lua_pop(L, 1);
   }
   lua_pop(L, 1);

@@ -700,7 +700,7 @@ static int dconn_tostring(lua_State *L)
   dfield(L, 1, "parent");
   if (!lua_isnil(L, -1))
     lua_pushfstring(L, "<Discrete connection '%s' on %s, from %s>", dm_conn_dc_rule(d->D)->name,
-                    dm_conn_dc_bundle(d->D)->name, luaL_tolstring(L, -1, NULL));
+                    dm_conn_dc_bundle(d->D)->name, dm_tolstring(L, -1, NULL));
   else
     lua_pushfstring(L, "<Discrete connection '%s' on %s>", dm_conn_dc_rule(d->D)->name,
                     dm_conn_dc_bundle(d->D)->name);

@@ -192,7 +192,7 @@ static int start_body(lua_State *L)
     while (lua_next(L, -2) != 0) {
       long j = -1;
       if (lua_type(L, -2) != LUA_TSTRING || (j = dm_lua_system_param(ls, lua_tostring(L, -2))) < 0) {
-        const char *bad = luaL_tolstring(L, -2, NULL);
+        const char *bad = dm_tolstring(L, -2, NULL);
         luaL_error(L, "dm.ensemble: params of member %d: no parameter %s in system '%s' "
                    "(parameters: %s)", (int)(c->k + 1), bad, ls->sys.name,
                    dm_lsystem_names(L, ls->sys.params, ls->sys.npar));
@@ -368,7 +368,7 @@ static void check_keys(lua_State *L, int t, const char *const *keys, const char 
     while (key && *k && strcmp(*k, key) != 0)
       k++;
     if (key == NULL || *k == NULL) {
-      const char *bad = luaL_tolstring(L, -2, NULL);
+      const char *bad = dm_tolstring(L, -2, NULL);
       luaL_Buffer b;
       luaL_buffinit(L, &b);
       for (k = keys; *k; k++) {
@@ -470,7 +470,7 @@ static unsigned read_reduce(lua_State *L, int *user, size_t *nuser)
       if (lua_type(L, -1) != LUA_TSTRING || (r = dm_ens_reducer_find(lua_tostring(L, -1))) < 0)
         luaL_error(L, "dm.ensemble: reduce[%d]: unknown reducer %s (built-in: final, "
                    "energy_error, min_distance, megno, fli, lyapunov)", (int)i,
-                   luaL_tolstring(L, -1, NULL));
+                   dm_tolstring(L, -1, NULL));
       bits |= DM_ENS_BIT(r);
       lua_pop(L, 1);
     }
@@ -588,7 +588,7 @@ static int l_ensemble(lua_State *L)
       long j = -1;
       lua_rawgeti(L, -2, (lua_Integer)i);
       if (lua_type(L, -1) != LUA_TSTRING || (j = dm_lua_system_coord(ls, lua_tostring(L, -1))) < 0) {
-        const char *bad = luaL_tolstring(L, -1, NULL);
+        const char *bad = dm_tolstring(L, -1, NULL);
         return luaL_error(L, "dm.ensemble: distance[%d]: no coordinate %s in system '%s' "
                           "(coordinates: %s)", (int)i, bad, ls->sys.name,
                           dm_lsystem_names(L, ls->sys.coords, ls->n));

@@ -140,7 +140,7 @@ int dm_linteg_order_estimate(lua_State *L)
     if (*kk == NULL)
       return luaL_error(L, "order_estimate: unknown option %s (options: state, t, h, reference; "
                         "the method and its options are the integrator's)",
-                        luaL_tolstring(L, -2, NULL));
+                        dm_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
   T = dm_optnumberfield(L, 2, "t", NAN);

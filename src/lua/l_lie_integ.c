@@ -89,7 +89,7 @@ int dm_lua_lie_integrator(lua_State *L)
     if (key == NULL || *k == NULL)
       return luaL_error(L, "dm.integrator: unknown option %s for a system on a Lie group "
                         "(options: method, h, stages, tol, maxiter, simplified)",
-                        luaL_tolstring(L, -2, NULL));
+                        dm_tolstring(L, -2, NULL));
     if (strcmp(key, "method") != 0) {
       double v;
       if (strcmp(key, "simplified") == 0 && lua_isboolean(L, -1))
@@ -154,7 +154,7 @@ static int l_run(lua_State *L)
       k++;
     if (key == NULL || *k == NULL)
       return luaL_error(L, "run: unknown option %s (options: t, steps, every, h, strict, warn)",
-                        luaL_tolstring(L, -2, NULL));
+                        dm_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
   dm_lua_run_check_flags(L, 3);
@@ -318,7 +318,7 @@ static int l_order_estimate(lua_State *L)
 static int l_index(lua_State *L)
 {
   dm_llinteg *li = checkinteg(L, 1);
-  const char *k = luaL_checkstring(L, 2);
+  const char *k = dm_checkcstring(L, 2);
   if (luaL_getmetafield(L, 1, "__methods") != LUA_TNIL) {
     lua_pushvalue(L, 2);
     if (lua_rawget(L, -2) != LUA_TNIL)

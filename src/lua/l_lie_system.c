@@ -180,7 +180,7 @@ int dm_lua_lie_system(lua_State *L)
       k++;
     if (key == NULL || *k == NULL)
       return luaL_error(L, "dm.system: unknown field %s for a system on a Lie group (fields: "
-                        "space, L, force, params, name, native)", luaL_tolstring(L, -2, NULL));
+                        "space, L, force, params, name, native)", dm_tolstring(L, -2, NULL));
     lua_pop(L, 1);
   }
   lua_getfield(L, 1, "space");                              /* 2 */
@@ -370,7 +370,7 @@ static int s_param(lua_State *L)
   dm_llsys *ls = dm_lua_checklsys(L, 1);
   dm_lie_system *S = ls->S;
   const dm_system *b = dm_lie_system_base(S);
-  const char *name = luaL_checkstring(L, 2);
+  const char *name = dm_checkcstring(L, 2);
   size_t i;
   for (i = 0; i < b->npar; i++)
     if (strcmp(b->params[i], name) == 0)
