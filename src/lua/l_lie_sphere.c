@@ -144,7 +144,7 @@ static int sphere_fields(lua_State *L)
     lua_pushinteger(L, (lua_Integer)n);
     return 1;
   }
-  return luaL_error(L, "S^%d has no field %s (fields: n)", (int)n, luaL_tolstring(L, 2, NULL));
+  return luaL_error(L, "S^%d has no field %s (fields: n)", (int)n, dm_tolstring(L, 2, NULL));
 }
 
 static int sphere_index(lua_State *L)
