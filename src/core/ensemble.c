@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -784,8 +785,11 @@ static int batch_user(ens *E, dm_err *e)
     long j = E->b0 + i;
     double *row = E->rows + (size_t)j * E->nvals;
     int st;
-    if (E->traj[i] == NULL)
+    if (E->traj[i] == NULL || dm_traj_len(E->traj[i]) == 0) {
+      dm_traj_free(E->traj[i]);      /* no sample to reduce: the values stay NaN */
+      E->traj[i] = NULL;
       continue;
+    }
     dm_err_clear(e);
     st = E->o->user(E->o->user_ctx, member_of(E, j), E->traj[i], row + 1, e);
     dm_traj_free(E->traj[i]);

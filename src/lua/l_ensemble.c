@@ -211,7 +211,9 @@ static int start_body(lua_State *L)
   }
   member_value(L, c, A_STATES, c->states_fn, "states");
   snprintf(fname, sizeof fname, "dm.ensemble: state of member %ld", c->k + 1);
-  dm_lua_readstate(L, ls, dm_linteg_check(L, S(A_INTEG))->I, -1, fname, c->buf, &s);
+  /* the system's own converter: the Legendre map needs no method, and the
+   * integrator is left alone (a parameter change would rebuild it) */
+  dm_lua_readstate(L, ls, ls->conv, -1, fname, c->buf, &s);
   memcpy(c->q, s.q, ls->n * sizeof *c->q);
   memcpy(c->p, s.p, ls->n * sizeof *c->p);
   return 0;

@@ -141,6 +141,12 @@ T.like(msg, "^dm%.ensemble: 1 of 6 members failed %(the first: member 4: step %d
 T.ok(res[4].status == 3 and res[4].t < 0.5 and res[3].status == 0 and res[5].t == 0.5
      and res:meta().failed == 1
      and res:meta()["failure.4"]:match("^member 4: "), "its row: status and time reached; the others are kept")
+local ur = dm.ensemble{integrator = I, members = 5, threads = 2, run = {steps = 50, every = 5},
+  states = function(k) if k == 4 then return {q = {1e-3, 0}, p = {0, 0}} end return start(k) end,
+  reduce = function(tr) return tr:meta().status, #tr end, columns = {"run_status", "samples"}}
+T.ok(ur[4].run_status == 3 and ur[4].status == 3 and ur[4].samples >= 1 and ur[4].samples < 11
+     and ur[3].run_status == 0 and ur[3].samples == 11,
+     "a reduce function sees a failed member's partial trajectory and its status")
 -- }==========================================================================
 
 -- {==== errors ==============================================================
