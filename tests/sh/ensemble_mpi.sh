@@ -7,7 +7,7 @@
 MPIRUN=${MPIRUN:-$(command -v mpirun)}
 built=$("$DMECH" -e 'io.write(tostring(dm.mpi.info().built))' 2>&1)
 if [ "$built" != true ]; then
-  skip "dmech was built without MPI (configure found no usable mpicc): MPI tests skipped"
+  skip "dmech was built without MPI (configure --without-mpi, or no usable mpicc): MPI tests skipped"
   done_testing
 fi
 if [ -z "$MPIRUN" ]; then
