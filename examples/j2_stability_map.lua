@@ -6,7 +6,9 @@
 --   src/dmech examples/j2_stability_map.lua [options]
 --   mpirun -np 2 src/dmech examples/j2_stability_map.lua [options]   (the same script)
 --
--- Options: --size NAxNI (default 40x24; the full map: --size 200x200),
+-- Options: --size NAxNI (default 40x24, about 25 ms of CPU per orbit: a
+--   minute for the three timed runs on 2 idle cores; the full map --size
+--   200x200 takes about 8 minutes there),
 --   --t T (default 1000), --h H (default 0.05), --j2 J (default 0.1),
 --   --tide K (default 0.003), --obliquity DEG (default 75),
 --   --a A0,A1 (default 1.2,3.2), --out FILE.png (default
@@ -41,7 +43,10 @@
 -- Gauss s = 2 (order 4, symplectic) with h = 0.05; the indicator is MEGNO
 -- <Y> from the exact step Jacobian (doc/ensembles.md §3): <Y> -> 2 for
 -- regular orbits and grows like lambda t / 2 on chaotic ones; pixels with
--- <Y> > 3 are called chaotic in the count.  Orbits that come within r < 1
+-- <Y> > 3 are called chaotic in the count.  At the defaults the chaotic
+-- orbits are the exactly polar ones inside the Laplace radius (the top
+-- row: their plane contains the companion's orbit normal), and the regular
+-- region is cut by bands of inclination whose orbits reach the surface.  Orbits that come within r < 1
 -- (min_distance over the samples) are marked "hits the planet", orbits
 -- that end beyond the Hill radius "escapes": their <Y> describes a path
 -- through the planet or out of the system.
