@@ -204,6 +204,7 @@ struct dm_integrator *dm_lua_tointegrator(lua_State *L, int idx);
 void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
 void dm_open_conn(lua_State *L);        /* dm.bundle, dm.connection, ... (l_conn*.c) */
 void dm_open_ensemble(lua_State *L);    /* dm.ensemble, dm.mpi, dm.rng (l_ensemble.c) */
+void dm_open_fields(lua_State *L);      /* dm.schrodinger, field integrators (l_fields.c) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

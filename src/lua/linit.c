@@ -20,6 +20,7 @@ static const dm_opener openers[] = {
   dm_open_lie,
   dm_open_conn,
   dm_open_ensemble,
+  dm_open_fields,
   NULL
 };
 
