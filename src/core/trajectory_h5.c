@@ -140,14 +140,23 @@ static hid_t string_type(void)
   return t;
 }
 
+/* A fixed-length (not variable-length) UTF-8 string: variable-length
+ * strings live in the file's global heap, whose reader in libhdf5 1.10
+ * crashes on damaged files (found by fuzzing dm.load_trajectory); h5py
+ * reads these as bytes (.decode() gives the str). */
 static int put_string(hid_t obj, const char *name, const char *value)
 {
-  hid_t t = string_type(), sp = H5Screate(H5S_SCALAR), a = -1;
+  hid_t t = H5Tcopy(H5T_C_S1), sp = H5Screate(H5S_SCALAR), a = -1;
   int ok = 0;
+  if (t >= 0 && (H5Tset_size(t, strlen(value) + 1) < 0 || H5Tset_cset(t, H5T_CSET_UTF8) < 0
+                 || H5Tset_strpad(t, H5T_STR_NULLTERM) < 0)) {
+    H5Tclose(t);
+    t = -1;
+  }
   if (t >= 0 && sp >= 0)
     a = H5Acreate2(obj, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
   if (a >= 0)
-    ok = H5Awrite(a, t, &value) >= 0;
+    ok = H5Awrite(a, t, value) >= 0;
   if (a >= 0)
     H5Aclose(a);
   if (sp >= 0)
@@ -411,8 +420,10 @@ static char *get_string(hid_t a)
     }
   } else {
     size_t n = H5Tget_size(t);
+    H5T_cset_t cs = H5Tget_cset(t);
     mt = H5Tcopy(H5T_C_S1);
-    if (mt >= 0 && H5Tset_size(mt, n + 1) >= 0 && (out = calloc(n + 2, 1)) != NULL
+    if (mt >= 0 && H5Tset_size(mt, n + 1) >= 0 && (cs < 0 || H5Tset_cset(mt, cs) >= 0)
+        && (out = calloc(n + 2, 1)) != NULL
         && H5Aread(a, mt, out) < 0) {
       free(out);
       out = NULL;
@@ -465,7 +476,7 @@ static herr_t on_attr(hid_t loc, const char *name, const H5A_info_t *info, void 
       && (H5Tget_class(t) == H5T_FLOAT || H5Tget_class(t) == H5T_INTEGER)) {
     if (H5Aread(a, H5T_NATIVE_DOUBLE, &m->x) >= 0 && (m->key = strdup(name)) != NULL)
       r->nmeta++;
-  } else if ((m->text = get_string(a)) != NULL) {
+  } else if ((m->text = get_string(a)) != NULL) {     /* other types: skipped */
     if ((m->key = strdup(name)) != NULL)
       r->nmeta++;
     else

@@ -4,8 +4,8 @@
  *   /                      root group; attributes:
  *     "dmech.format"       "trajectory 1" (string)
  *     <key>                every metadata item, in order: a 64-bit float
- *                          scalar for numbers, a variable-length UTF-8
- *                          string otherwise ("method", "h", "param.mu", ...)
+ *                          scalar for numbers, a fixed-length UTF-8 string
+ *                          otherwise ("method", "h", "param.mu", ...)
  *   /<column name>         one dataset per column, in column order (link
  *                          creation order is tracked): 1-D, little-endian
  *                          64-bit floats, one value per sample; attribute
@@ -13,6 +13,12 @@
  *                          "data"
  * A column name containing '/' cannot name a dataset (DM_EINVAL); the
  * metadata key "dmech.format" is reserved.
+ *
+ * Strings are written fixed-length: variable-length ones live in the
+ * file's global heap, which libhdf5 1.10 reads past its bounds when the
+ * file is damaged (a crash the fuzzer found); files from elsewhere may
+ * still hold variable-length strings, which are read (and expose that
+ * library bug).
  *
  * Loading accepts files written here and plain HDF5 files whose root holds
  * 1-D numeric datasets of one length, one of them called "t" (the others

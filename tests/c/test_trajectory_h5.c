@@ -139,6 +139,17 @@ static void foreign(void)
     H5Sclose(sc);
   }
   H5Tclose(st);
+  {                                  /* a variable-length UTF-8 string, as h5py writes */
+    hid_t vt = H5Tcopy(H5T_C_S1), sc = H5Screate(H5S_SCALAR);
+    const char *note = "written by h5py \xc3\xa9";
+    H5Tset_size(vt, H5T_VARIABLE);
+    H5Tset_cset(vt, H5T_CSET_UTF8);
+    a = H5Acreate2(f, "note", vt, sc, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, vt, &note);
+    H5Aclose(a);
+    H5Sclose(sc);
+    H5Tclose(vt);
+  }
   H5Sclose(sp);
   H5Sclose(s2);
   H5Fclose(f);
@@ -146,8 +157,9 @@ static void foreign(void)
   tap_ok(tr != NULL && dm_traj_len(tr) == 4 && dm_traj_ncols(tr) == 2
          && dm_traj_col(tr, 1)[2] == 4.0 && dm_traj_col(tr, 0)[3] == 1.5
          && strcmp(dm_traj_meta_get(tr, "author"), "ada!!") == 0
+         && strcmp(dm_traj_meta_get(tr, "note"), "written by h5py \xc3\xa9") == 0
          && dm_traj_meta_get(tr, "pair") == NULL,
-         "a plain HDF5 file: t and an integer column, a string attribute%s%s", tr ? "" : ": ",
+         "a plain HDF5 file: t and an integer column, fixed and variable-length strings%s%s", tr ? "" : ": ",
          tr ? "" : e.msg);
   dm_traj_free(tr);
 }

@@ -32,6 +32,7 @@ local READERS = {
   {name = "csv", load = function(p) return dm.load_trajectory(p) end, seeds = "gen:*.csv"},
   {name = "mesh", load = function(p) return dm.mesh.load(p) end,
    seeds = "tests/data/dec/*.off tests/data/dec/*.obj tests/data/dec/*.msh"},
+  {name = "hdf5", load = function(p) return dm.load_trajectory(p) end, seeds = "tests/data/ensemble/*.h5"},
 }
 
 -- Functions not fuzzed: they end the process, print TAP or pass raw

@@ -215,7 +215,7 @@ else
 end
 local p, text
 p = io.popen("/usr/bin/python3 -c 'import h5py, sys; f = h5py.File(sys.argv[1], \"r\"); "
-  .. "print(repr(float(f[\"megno\"][4])), f.attrs[\"method\"], list(f.keys())[:2])' " .. f5 .. " 2>/dev/null")
+  .. "print(repr(float(f[\"megno\"][4])), f.attrs[\"method\"].decode(), list(f.keys())[:2])' " .. f5 .. " 2>/dev/null")
 text = p and p:read("a") or ""
 if p then p:close() end
 if text == "" then
