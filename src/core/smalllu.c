@@ -7,6 +7,7 @@
 #include <float.h>
 #include <math.h>
 #include <gsl/gsl_linalg.h>
+#include <gsl/gsl_vector.h>
 
 /* Right-looking elimination (the classical kji loop), rows swapped whole so
  * that the interchanges can be applied to b up front; the diagonal keeps
@@ -78,6 +79,16 @@ static void solve_small(const double *restrict a, size_t n, const size_t *restri
   }
 }
 
+int dm_gsl_lu_decomp(gsl_matrix *A, gsl_permutation *p, int *signum)
+{
+  size_t m = A->size1 < A->size2 ? A->size1 : A->size2;
+  gsl_vector_uint *probe = gsl_vector_uint_alloc(m > 0 ? m : 1);
+  if (probe == NULL)
+    return DM_ENOMEM;
+  gsl_vector_uint_free(probe);
+  return gsl_linalg_LU_decomp(A, p, signum) == GSL_SUCCESS ? DM_OK : DM_EFAILED;
+}
+
 static int factor_gsl(double *a, size_t n, size_t *perm)
 {
   gsl_matrix_view A = gsl_matrix_view_array(a, n, n);
@@ -87,7 +98,8 @@ static int factor_gsl(double *a, size_t n, size_t *perm)
   int signum;
   if (!(amax < HUGE_VAL))
     return DM_EDOM;
-  gsl_linalg_LU_decomp(&A.matrix, &P, &signum);
+  if (dm_gsl_lu_decomp(&A.matrix, &P, &signum) == DM_ENOMEM)
+    return DM_ENOMEM;
   for (i = 0; i < n; i++) {
     double t = fabs(a[i * n + i]);
     umin = t < umin ? t : umin;

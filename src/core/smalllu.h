@@ -35,7 +35,8 @@
  * owns a, perm (room for n) and b.  Above it, GSL >= 2.7 allocates a pivot
  * vector inside gsl_linalg_LU_decomp (a malloc/free per factorisation).
  *
- * Errors.  dm_smalllu_factor returns DM_OK; DM_EDOM (a is left unchanged)
+ * Errors.  dm_smalllu_factor returns DM_OK; DM_ENOMEM (above
+ * DM_SMALLLU_NMAX only: GSL's pivot vector); DM_EDOM (a is left unchanged)
  * when an entry is NaN or infinite; DM_ESINGULAR when a pivot |U_kk| is not
  * above 16 n eps max|a_ij| (a relative test, independent of the scale of a;
  * a is then partly factored and must not be passed to the solve).  No
@@ -45,6 +46,16 @@
 #define DM_SMALLLU_H
 
 #include <stddef.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_permutation.h>
+
+/* gsl_linalg_LU_decomp, safe when memory runs out: GSL 2.7 allocates a
+ * pivot vector inside and dereferences it even when that allocation
+ * failed (a crash found by refusing allocations one at a time,
+ * tests/c/test_fault_alloc.c).  The same allocation is tried first, and
+ * DM_ENOMEM returned when it fails; else DM_OK (or DM_EFAILED for GSL's
+ * own errors). */
+int dm_gsl_lu_decomp(gsl_matrix *A, gsl_permutation *p, int *signum);
 
 /* Sizes up to this use the kernel in smalllu.c, larger ones GSL. */
 #define DM_SMALLLU_NMAX 128

@@ -65,7 +65,7 @@ static int galerkin_fill(dm_tableau *t, dm_err *e)
   size_t s = t->s, i, j, k;
   gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc(s);
   if (gl == NULL)
-    return dm_err_set(e, DM_ENOMEM, "tableau: cannot allocate the %zu-point Gauss rule", s);
+    return dm_err_set(e, DM_ENOMEM, "tableau: out of memory for the %zu-point Gauss rule", s);
   for (i = 0; i < s; i++) {
     long double bi = 0.0L;
     for (k = 0; k < s; k++) {
@@ -154,7 +154,7 @@ int dm_tableau_gauss(size_t s, dm_tableau **out, dm_err *e)
     return dm_err_set(e, DM_ENOMEM, "gauss: out of memory");
   if ((gl = gsl_integration_glfixed_table_alloc(s)) == NULL) {
     dm_tableau_free(t);
-    return dm_err_set(e, DM_ENOMEM, "gauss: cannot allocate the Gauss rule");
+    return dm_err_set(e, DM_ENOMEM, "gauss: out of memory for the Gauss rule");
   }
   for (i = 0; i < s; i++) {
     double w;

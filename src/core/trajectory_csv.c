@@ -147,6 +147,11 @@ static int next_line(reader *r)
   errno = 0;
   k = getline(&r->line, &r->cap, r->f);
   if (k < 0) {
+    if (errno == ENOMEM) {          /* not the end of the file */
+      dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory at line %zu", r->path,
+                 r->lineno + 1);
+      return -1;
+    }
     if (ferror(r->f)) {
       dm_err_set(r->e, DM_EIO, "reading '%.200s': %s", r->path,
                  strerror(errno ? errno : EIO));

@@ -150,8 +150,10 @@ long dm_expr_free_vars(dm_expr_ctx *ctx, dm_expr e, dm_expr *out, size_t max)
   if (!dm_expr__valid(ctx, e))
     return -1;
   long nl = collect(ctx, 1, &e, no_vars, NULL);
-  if (nl < 0)
+  if (nl < 0) {
+    dm_expr__fail(ctx, DM_ENOMEM, "expression: out of memory");
     return -1;
+  }
   long cnt = 0;
   for (long i = 0; i < nl; i++) {
     int op = ctx->node[ctx->list[i]].op;

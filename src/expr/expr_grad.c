@@ -474,7 +474,7 @@ static int oom_err(dm_err *err, const char *who)
   return dm_err_set(err, DM_ENOMEM, "%s: out of memory", who);
 }
 
-int dm_expr_grad(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
+static int grad_impl(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
                  dm_expr *grad, dm_err *err)
 {
   int s = check_vars(ctx, e, n, vars, "grad", err);
@@ -540,7 +540,7 @@ static int to_sparse(rows *r, const size_t *off, size_t nrow, size_t ncol,
   return 0;
 }
 
-int dm_expr_jacobian_sparse(dm_expr_ctx *ctx, size_t m, const dm_expr *f,
+static int jacobian_sparse_impl(dm_expr_ctx *ctx, size_t m, const dm_expr *f,
                             size_t n, const dm_expr *vars, dm_expr_sparse *J,
                             dm_err *err)
 {
@@ -869,7 +869,7 @@ done:
   return s;
 }
 
-int dm_expr_hessian_sparse(dm_expr_ctx *ctx, dm_expr e, size_t n,
+static int hessian_sparse_impl(dm_expr_ctx *ctx, dm_expr e, size_t n,
                            const dm_expr *vars, dm_expr_sparse *H, dm_err *err)
 {
   memset(H, 0, sizeof *H);
@@ -899,7 +899,7 @@ int dm_expr_hessian_sparse(dm_expr_ctx *ctx, dm_expr e, size_t n,
   return s;
 }
 
-int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
+static int hessian_impl(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
                     dm_expr *H, dm_err *err)
 {
   int s = check_vars(ctx, e, n, vars, "hessian", err);
@@ -934,4 +934,59 @@ int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
   rows_free(&r);
   free(off);
   return s;
+}
+
+/* {==================================================================
+ * the public entry points: a failure is also left in the context's error
+ * when the caller passed no dm_err (as the node constructors report), so
+ * that a caller reading the context learns why ("out of memory", not an
+ * empty message)
+ * =================================================================== */
+
+static int keep(dm_expr_ctx *ctx, int s, const dm_err *local)
+{
+  if (s != DM_OK && ctx->err.status == DM_OK && local->status != DM_OK)
+    ctx->err = *local;
+  return s;
+}
+
+int dm_expr_grad(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
+                 dm_expr *grad, dm_err *err)
+{
+  dm_err local;
+  if (err != NULL)
+    return grad_impl(ctx, e, n, vars, grad, err);
+  dm_err_clear(&local);
+  return keep(ctx, grad_impl(ctx, e, n, vars, grad, &local), &local);
+}
+
+int dm_expr_jacobian_sparse(dm_expr_ctx *ctx, size_t m, const dm_expr *f,
+                            size_t n, const dm_expr *vars, dm_expr_sparse *J,
+                            dm_err *err)
+{
+  dm_err local;
+  if (err != NULL)
+    return jacobian_sparse_impl(ctx, m, f, n, vars, J, err);
+  dm_err_clear(&local);
+  return keep(ctx, jacobian_sparse_impl(ctx, m, f, n, vars, J, &local), &local);
+}
+
+int dm_expr_hessian_sparse(dm_expr_ctx *ctx, dm_expr e, size_t n,
+                           const dm_expr *vars, dm_expr_sparse *H, dm_err *err)
+{
+  dm_err local;
+  if (err != NULL)
+    return hessian_sparse_impl(ctx, e, n, vars, H, err);
+  dm_err_clear(&local);
+  return keep(ctx, hessian_sparse_impl(ctx, e, n, vars, H, &local), &local);
+}
+
+int dm_expr_hessian(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *vars,
+                    dm_expr *H, dm_err *err)
+{
+  dm_err local;
+  if (err != NULL)
+    return hessian_impl(ctx, e, n, vars, H, err);
+  dm_err_clear(&local);
+  return keep(ctx, hessian_impl(ctx, e, n, vars, H, &local), &local);
 }

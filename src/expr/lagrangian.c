@@ -240,6 +240,8 @@ static int check_vars(builder *b, dm_expr e, const char *what, size_t na,
 {
   dm_expr fv1[64], *fv = fv1;
   long k = dm_expr_free_vars(b->ctx, e, NULL, 0);
+  if (k < 0 && dm_expr_ctx_err(b->ctx)->status == DM_ENOMEM)
+    return ctx_fail(b, what);
   if (k < 0)
     return dm_err_set(b->err, DM_EINVAL, "%s is not a valid expression", what);
   if (k > 64 && (fv = malloc((size_t)k * sizeof *fv)) == NULL)
@@ -421,9 +423,11 @@ int dm_lagrangian_outputs(dm_expr_ctx *ctx, dm_expr L, size_t n, const dm_expr *
   out[0] = L;
   /* gradient and Hessian in (q, v) at once: the Hessian routine shares the
    * chain rule through common subexpressions between all the blocks */
-  if (dm_expr_grad(ctx, L, m, in, out + 1, NULL) != DM_OK ||
-      dm_expr_hessian(ctx, L, m, in, H, NULL) != DM_OK) {
-    const dm_err *ce = dm_expr_ctx_err(ctx);
+  dm_err ge;                     /* their own message (out of memory) */
+  dm_err_clear(&ge);
+  if (dm_expr_grad(ctx, L, m, in, out + 1, &ge) != DM_OK ||
+      dm_expr_hessian(ctx, L, m, in, H, &ge) != DM_OK) {
+    const dm_err *ce = ge.msg[0] ? &ge : dm_expr_ctx_err(ctx);
     free(H);
     return dm_err_set(err, ce->status ? ce->status : DM_EFAILED, "L: %s",
                       ce->msg[0] ? ce->msg : "cannot build the derivatives");

@@ -69,8 +69,13 @@ dm_expr dm_lua_toexpr(lua_State *L, int idx)
   dm_expr *u = luaL_testudata(L, idx, DM_EXPR_MT);
   if (u != NULL)
     return *u;
-  if (lua_type(L, idx) == LUA_TNUMBER)
-    return dm_expr_const(dm_lua_exprctx(L), lua_tonumber(L, idx));
+  if (lua_type(L, idx) == LUA_TNUMBER) {
+    dm_expr_ctx *ctx = dm_lua_exprctx(L);
+    dm_expr e = dm_expr_const(ctx, lua_tonumber(L, idx));
+    if (e == DM_EXPR_NONE)        /* out of memory, not a wrong operand */
+      dm_lua_ctx_raise(L, ctx);
+    return e;
+  }
   return DM_EXPR_NONE;
 }
 

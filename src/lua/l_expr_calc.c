@@ -178,8 +178,13 @@ static int e_hessian(lua_State *L)
   dm_expr_ctx *ctx = dm_lua_exprctx(L);
   dm_expr *H = lua_newuserdatauv(L, n * n * sizeof *H, 0);
   dm_err err;
-  if (dm_expr_hessian(ctx, e, n, x, H, &err) != DM_OK)
-    return dm_lua_ctx_raise(L, ctx);
+  dm_err_clear(&err);
+  if (dm_expr_hessian(ctx, e, n, x, H, &err) != DM_OK) {
+    if (err.msg[0] == '\0')
+      return dm_lua_ctx_raise(L, ctx);
+    dm_expr_ctx_clear_err(ctx);
+    return luaL_error(L, "%s", err.msg);
+  }
   lua_createtable(L, (int)n, 0);
   for (size_t i = 0; i < n; i++) {
     lua_createtable(L, (int)n, 0);

@@ -11,7 +11,11 @@
 
 int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e)
 {
-  const char *msg = (e != NULL && e->msg[0] != '\0') ? e->msg : dm_strstatus(status);
+  /* a record the failing call did not fill (its status differs) is not
+   * trusted: its message may be stale or never written */
+  const char *msg = (e != NULL && e->status == status && e->msg[0] != '\0'
+                     && memchr(e->msg, '\0', sizeof e->msg) != NULL)
+                    ? e->msg : dm_strstatus(status);
   return luaL_error(L, "%s: %s", what, msg);
 }
 

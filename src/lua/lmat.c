@@ -14,6 +14,7 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_permutation.h>
 
+#include "core/smalllu.h"
 #include "lua/dmlua.h"
 
 /* {======================================================================
@@ -244,12 +245,17 @@ static int mt_norm(lua_State *L)
 }
 
 /* LU factorization of a copy of the square matrix at 1.  The copy (a mat)
- * and the permutation storage are pushed, so nothing can leak. */
+ * and the permutation storage are pushed, so nothing can leak.  Up to
+ * DM_SMALLLU_NMAX the allocation-free kernel of core/smalllu.h factors
+ * (GSL 2.7's LU allocates a pivot vector inside and crashes when that
+ * allocation fails -- found by tests/c/test_fault_alloc.c); larger
+ * matrices go to GSL through dm_gsl_lu_decomp. */
 typedef struct lu {
   gsl_matrix *a;
   gsl_permutation p;
   int sign;
   int singular;
+  int small;          /* factored by dm_smalllu_factor (its layout) */
 } lu;
 
 static void lu_factor(lua_State *L, const char *what, lu *f)
@@ -258,19 +264,52 @@ static void lu_factor(lua_State *L, const char *what, lu *f)
   size_t i, n = m->size1;
   f->a = dm_pushmat_copy(L, m);
   f->p.size = n;
-  f->p.data = lua_newuserdatauv(L, n * sizeof(size_t), 0);
-  gsl_linalg_LU_decomp(f->a, &f->p, &f->sign);
+  f->p.data = lua_newuserdatauv(L, (n > 0 ? n : 1) * sizeof(size_t), 0);
+  f->small = n <= DM_SMALLLU_NMAX && f->a->tda == n;
   f->singular = 0;
+  f->sign = 1;
+  if (f->small) {
+    int st = dm_smalllu_factor(f->a->data, n, f->p.data);
+    f->singular = st != DM_OK;
+    for (i = 0; !f->singular && i < n; i++)
+      if (f->p.data[i] != i)
+        f->sign = -f->sign;
+    return;
+  }
+  if (dm_gsl_lu_decomp(f->a, &f->p, &f->sign) == DM_ENOMEM)
+    luaL_error(L, "%s: out of memory", what);
   for (i = 0; i < n; i++)
     if (gsl_matrix_get(f->a, i, i) == 0.0 || !isfinite(gsl_matrix_get(f->a, i, i)))
       f->singular = 1;
 }
 
+/* x = A^-1 b with the factors (b and x may be the same vector). */
+static void lu_solve(const lu *f, const gsl_vector *b, gsl_vector *x)
+{
+  size_t n = f->a->size1;
+  if (f->small) {
+    gsl_vector_memcpy(x, b);
+    dm_smalllu_solve(f->a->data, n, f->p.data, x->data);
+  } else {
+    gsl_linalg_LU_solve(f->a, &f->p, b, x);
+  }
+}
+
 static int mt_det(lua_State *L)
 {
   lu f;
+  double d = 1.0;
+  size_t i, n;
   lu_factor(L, "det", &f);
-  lua_pushnumber(L, f.singular ? 0.0 : gsl_linalg_LU_det(f.a, f.sign));
+  n = f.a->size1;
+  if (f.singular)
+    d = 0.0;
+  else if (f.small)
+    for (i = 0; i < n; i++)
+      d /= gsl_matrix_get(f.a, i, i);        /* the kernel keeps 1/U_kk */
+  else
+    d = gsl_linalg_LU_det(f.a, f.sign);
+  lua_pushnumber(L, f.small && !f.singular ? f.sign * d : d);
   return 1;
 }
 
@@ -278,12 +317,27 @@ static int mt_inv(lua_State *L)
 {
   lu f;
   gsl_matrix *r;
+  size_t j, n;
   lu_factor(L, "inv", &f);
   if (f.singular)
     return luaL_error(L, "inv: matrix is singular");
-  r = dm_pushmat(L, f.a->size1, f.a->size2);
-  if (gsl_linalg_LU_invert(f.a, &f.p, r) != GSL_SUCCESS)
-    return luaL_error(L, "inv: matrix is singular");
+  n = f.a->size1;
+  r = dm_pushmat(L, n, n);
+  if (!f.small) {
+    if (gsl_linalg_LU_invert(f.a, &f.p, r) != GSL_SUCCESS)
+      return luaL_error(L, "inv: matrix is singular");
+    return 1;
+  }
+  {
+    gsl_vector *e = dm_pushvec(L, n);          /* contiguous column buffer */
+    for (j = 0; j < n; j++) {                  /* column j: A x = e_j */
+      gsl_vector_view c = gsl_matrix_column(r, j);
+      gsl_vector_set_basis(e, j);
+      dm_smalllu_solve(f.a->data, n, f.p.data, e->data);
+      gsl_vector_memcpy(&c.vector, e);
+    }
+    lua_pop(L, 1);
+  }
   return 1;
 }
 
@@ -296,8 +350,7 @@ static int mt_solve(lua_State *L)
   if (f.singular)
     return luaL_error(L, "solve: matrix is singular");
   x = dm_pushvec(L, m->size1);
-  if (gsl_linalg_LU_solve(f.a, &f.p, b, x) != GSL_SUCCESS)
-    return luaL_error(L, "solve: matrix is singular");
+  lu_solve(&f, b, x);
   return 1;
 }
 

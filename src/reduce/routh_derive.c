@@ -531,6 +531,10 @@ static int derive(dm_expr_ctx *ctx, const dm_routh_spec *sp, dm_routh **out, dm_
     N.th[a] = sp->q[red->cyc[a]];
     N.thd_sym[a] = sp->v[red->cyc[a]];
     N.mu[a] = dm_expr_param(ctx, red->names[red->s + sp->npar + a]);
+    if (N.mu[a] == DM_EXPR_NONE) {          /* out of memory: say so here, */
+      st = ctx_fail(ctx, e, "mu");           /* before the context is reset */
+      goto fail;
+    }
   }
   dm_expr_ctx_clear_err(ctx);
   st = mechanical(ctx, sp, &N, tmp, e);

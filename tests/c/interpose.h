@@ -51,6 +51,7 @@ static inline void ip_fail_at(long k)
 
 #if IP_ACTIVE
 #include <dlfcn.h>
+#include <errno.h>
 #include <malloc.h>
 #include <string.h>
 
@@ -91,12 +92,13 @@ static void ip_resolve(void)
   ip_resolving = 0;
 }
 
-/* Count one allocation; 1 when it must fail. */
+/* Count one allocation; 1 when it must fail (errno ENOMEM, as malloc). */
 static int ip_refuse(void)
 {
   ip_count++;
   if (ip_fail_k != 0 && ip_count == ip_fail_k) {
     ip_failures++;
+    errno = ENOMEM;
     return 1;
   }
   return 0;
