@@ -145,11 +145,21 @@ static int block_file(dm_gp_session *s, const char *name, size_t nrows,
   *done = i;
   fputs("EOD\n", f);
   gp_log(s, "EOD\n");
-  bad = ferror(f);
-  if (fclose(f) != 0 || bad) {
-    unlink(path);
-    return dm_err_set(e, DM_EIO, "cannot write plot data '%s' (disk full?)",
-                      path);
+  errno = 0;
+  bad = fflush(f) != 0 || ferror(f);
+  if (bad && errno == 0)
+    errno = EIO;
+  {
+    int err = errno;
+    if (fclose(f) != 0 && !bad) {
+      bad = 1;
+      err = errno;
+    }
+    if (bad) {
+      unlink(path);
+      return dm_err_set(e, DM_EIO, "cannot write plot data '%s': %s", path,
+                        strerror(err));
+    }
   }
   rc = gp_send_unlogged(s, "load ", 5, e);
   if (rc == DM_OK)

@@ -318,9 +318,57 @@ int gp_output_close(dm_gp_session *s, dm_err *e)
   return gp_append(s, cmd, sizeof cmd - 1, e);
 }
 
+/* Does the file gnuplot wrote end as its format must?  gnuplot does not
+ * report a failed write (a full disk, RLIMIT_FSIZE, being killed): a
+ * truncated PNG was renamed over the older good file.  The format is told
+ * by the first bytes, the end checked by the last ones (PNG: IEND chunk,
+ * PDF/PostScript: %%EOF, SVG: </svg>, GIF: 0x3B, JPEG: FFD9); an empty
+ * file is incomplete; other formats (text) pass. */
+static int output_complete(const char *path)
+{
+  unsigned char head[8], tail[64];
+  size_t nh, nt;
+  long size;
+  FILE *f = fopen(path, "rb");
+  int ok = 1;
+  if (f == NULL)
+    return 0;
+  nh = fread(head, 1, sizeof head, f);
+  if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) <= 0) {
+    fclose(f);
+    return 0;
+  }
+  fseek(f, size > (long)sizeof tail ? size - (long)sizeof tail : 0, SEEK_SET);
+  nt = fread(tail, 1, sizeof tail, f);
+  fclose(f);
+#define ENDS(lit) (nt >= sizeof(lit) - 1 \
+                   && memcmp(tail + nt - (sizeof(lit) - 1), lit, sizeof(lit) - 1) == 0)
+#define HAS(lit) (memmem(tail, nt, lit, sizeof(lit) - 1) != NULL)
+  if (nh >= 8 && memcmp(head, "\x89PNG\r\n\x1a\n", 8) == 0)
+    ok = ENDS("IEND\xae\x42\x60\x82");
+  else if (nh >= 4 && (memcmp(head, "%PDF", 4) == 0 || memcmp(head, "%!PS", 4) == 0))
+    ok = HAS("%%EOF");
+  else if (nh >= 5 && (memcmp(head, "<?xml", 5) == 0 || memcmp(head, "<svg", 4) == 0))
+    ok = HAS("</svg>");
+  else if (nh >= 4 && memcmp(head, "GIF8", 4) == 0)
+    ok = tail[nt - 1] == 0x3b;
+  else if (nh >= 2 && head[0] == 0xff && head[1] == 0xd8)
+    ok = ENDS("\xff\xd9");
+#undef ENDS
+#undef HAS
+  return ok;
+}
+
 int gp_output_commit(dm_gp_session *s, dm_err *e)
 {
   s->out_open = 0;
+  if (s->out.tmp != NULL && !output_complete(s->out.tmp)) {
+    int rc = dm_err_set(e, DM_EIO, "plot output '%.200s': the file gnuplot wrote is "
+                        "incomplete (disk full or a file size limit?); nothing was "
+                        "replaced", s->out.path);
+    dm_outfile_abandon(&s->out);
+    return rc;
+  }
   return dm_outfile_commit(&s->out, e);
 }
 
