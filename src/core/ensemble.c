@@ -104,7 +104,8 @@ struct ens {
   dm_integ_opts opt;        /* I0's options (copies: the callbacks may rebuild I0) */
   const dm_ens_opts *o;
   dm_run_opts run;          /* nsteps resolved */
-  size_t n, npar, nvals;    /* values per row: t, reducers, user, status */
+  size_t n, nq, npar, nvals;  /* momenta, numbers per q; values per row: t, reducers,
+                               user, status */
   size_t col_status;
   int variational, samples, user;
   /* this rank's members: k = first + j * stride, j < count */
@@ -113,7 +114,7 @@ struct ens {
   char **msg;               /* count */
   /* the batch */
   long b0, nb;
-  double *q0, *p0, *par0;   /* nb x n, nb x n, nb x npar */
+  double *q0, *p0, *par0;   /* nb x nq, nb x n, nb x npar */
   dm_traj **traj;           /* nb (user mode) */
   atomic_long next, done, failed;
   atomic_int stop;
@@ -161,16 +162,16 @@ static void worker_free(worker *w)
 static int worker_init(ens *E, worker *w, dm_err *e)
 {
   const dm_system *s = E->sys;
-  size_t n = E->n, big = n * n, k;
+  size_t n = E->n, nq = E->nq, big = n * n, k;
   memset(w, 0, sizeof *w);
   w->E = E;
-  /* q p v qs ps (n each), D (4 n^2), d dn (2n each) */
-  if ((w->q = calloc(5 * n + 4 * n * n + 4 * n + 1, sizeof(double))) == NULL)
+  /* q (nq) p v (n) qs (nq) ps (n), D (4 n^2), d dn (2n each) */
+  if ((w->q = calloc(2 * nq + 3 * n + 4 * n * n + 4 * n + 1, sizeof(double))) == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
-  w->p = w->q + n;
+  w->p = w->q + nq;
   w->v = w->p + n;
   w->qs = w->v + n;
-  w->ps = w->qs + n;
+  w->ps = w->qs + nq;
   w->D = w->ps + n;
   w->d = w->D + 4 * n * n;
   w->dn = w->d + 2 * n;
@@ -259,7 +260,7 @@ static int prepare(worker *w, long i, dm_err *e)
   w->have_par = 1;
   dm_integrator_free(w->I);
   w->I = NULL;
-  if ((st = refresh_mass(w, E->q0 + (size_t)i * E->n, e)) != DM_OK)
+  if ((st = refresh_mass(w, E->q0 + (size_t)i * E->nq, e)) != DM_OK)
     return st;
   return dm_integrator_new(&w->sys, E->method, &E->opt, &w->I, e);
 }
@@ -277,7 +278,7 @@ static double dist_of(const ens *E, const double *q)
 {
   double s = 0.0;
   size_t i;
-  for (i = 0; i < E->n; i++)
+  for (i = 0; i < E->nq; i++)
     if (E->o->dist == NULL || E->o->dist[i])
       s += q[i] * q[i];
   return sqrt(s);
@@ -298,7 +299,7 @@ static int sample(worker *w, long j, long k, acc *a, int first)
   unsigned r = E->o->reduce;
   char tb[DM_NUM_BUFSIZE];
   dm_err le;
-  if (!finite_vec(w->q, n) || !finite_vec(w->p, n)) {
+  if (!finite_vec(w->q, E->nq) || !finite_vec(w->p, n)) {
     member_message(E, j, "the state became non-finite (NaN or Inf) by step %ld of %ld (t = %s): "
                    "the run diverged", k, E->run.nsteps, time_text(E, k, tb));
     return DM_EDIVERGED;
@@ -338,7 +339,7 @@ static int sample(worker *w, long j, long k, acc *a, int first)
     if (first || d < a->dmin)
       a->dmin = d;
   }
-  memcpy(w->qs, w->q, n * sizeof *w->q);
+  memcpy(w->qs, w->q, E->nq * sizeof *w->q);
   memcpy(w->ps, w->p, n * sizeof *w->p);
   return DM_OK;
 }
@@ -385,14 +386,14 @@ static int member_steps(worker *w, long i, long j, acc *a, long *kout, long *ks)
   ens *E = w->E;
   const dm_run_opts *ro = &E->run;
   long k = 0, N = ro->nsteps;
-  size_t n = E->n, m;
+  size_t n = E->n, nq = E->nq, m;
   char tb[DM_NUM_BUFSIZE];
   dm_err le;
   int st;
   *kout = *ks = 0;
-  memcpy(w->q, E->q0 + (size_t)i * n, n * sizeof *w->q);
+  memcpy(w->q, E->q0 + (size_t)i * nq, nq * sizeof *w->q);
   memcpy(w->p, E->p0 + (size_t)i * n, n * sizeof *w->p);
-  memcpy(w->qs, w->q, n * sizeof *w->q);
+  memcpy(w->qs, w->q, nq * sizeof *w->q);
   memcpy(w->ps, w->p, n * sizeof *w->p);
   dm_err_clear(&le);
   if ((st = prepare(w, i, &le)) != DM_OK) {
@@ -435,8 +436,8 @@ static int member_steps(worker *w, long i, long j, acc *a, long *kout, long *ks)
     *ks = k;
   }
   /* stopped between samples: the state where it stopped is good */
-  if (st != DM_OK && finite_vec(w->q, n) && finite_vec(w->p, n)) {
-    memcpy(w->qs, w->q, n * sizeof *w->q);
+  if (st != DM_OK && finite_vec(w->q, nq) && finite_vec(w->p, n)) {
+    memcpy(w->qs, w->q, nq * sizeof *w->q);
     memcpy(w->ps, w->p, n * sizeof *w->p);
     *ks = k;
   }
@@ -448,7 +449,7 @@ static void builtin_member(worker *w, long i)
   ens *E = w->E;
   const dm_run_opts *ro = &E->run;
   long j = E->b0 + i, k, ks;
-  size_t n = E->n, c = 0;
+  size_t n = E->n, nq = E->nq, c = 0;
   double *row = E->rows + (size_t)j * E->nvals;
   unsigned r = E->o->reduce;
   acc a;
@@ -457,9 +458,9 @@ static void builtin_member(worker *w, long i)
   st = member_steps(w, i, j, &a, &k, &ks);
   row[c++] = ro->t0 + (double)ks * ro->h;
   if (r & DM_ENS_BIT(DM_ENS_FINAL)) {
-    memcpy(row + c, w->qs, n * sizeof *row);
-    memcpy(row + c + n, w->ps, n * sizeof *row);
-    c += 2 * n;
+    memcpy(row + c, w->qs, nq * sizeof *row);
+    memcpy(row + c + nq, w->ps, n * sizeof *row);
+    c += nq + n;
   }
   if (r & DM_ENS_BIT(DM_ENS_ENERGY_ERROR))
     row[c++] = a.dE;
@@ -481,13 +482,13 @@ static void user_member(worker *w, long i)
 {
   ens *E = w->E;
   long j = E->b0 + i;
-  size_t n = E->n;
+  size_t n = E->n, nq = E->nq;
   double *row = E->rows + (size_t)j * E->nvals;
   dm_run_result res;
   dm_err le;
   dm_traj *tr;
   int st;
-  memcpy(w->q, E->q0 + (size_t)i * n, n * sizeof *w->q);
+  memcpy(w->q, E->q0 + (size_t)i * nq, nq * sizeof *w->q);
   memcpy(w->p, E->p0 + (size_t)i * n, n * sizeof *w->p);
   row[0] = NAN;
   if ((st = prepare(w, i, &le)) != DM_OK) {
@@ -621,6 +622,10 @@ static int check_opts(const dm_integrator *I, const dm_ens_opts *o, dm_run_opts 
   if ((o->reduce & DM_ENS_VARIATIONAL) && I->m > 0)
     return dm_err_set(e, DM_EUNSUP, "megno, fli and lyapunov need the step Jacobian, which "
                       "constrained systems do not have");
+  if ((o->reduce & DM_ENS_VARIATIONAL) && I->nq != I->n)
+    return dm_err_set(e, DM_EUNSUP, "megno, fli and lyapunov need the step Jacobian in "
+                      "coordinates, which a configuration stored in %zu numbers with %zu "
+                      "velocities (a system on a group) does not have", I->nq, I->n);
   *run = o->run;
   run->progress = NULL;
   run->piece = 0;
@@ -653,12 +658,12 @@ static dm_traj *new_table(const ens *E, dm_err *e)
   if (tr == NULL)
     return NULL;
   if (r & DM_ENS_BIT(DM_ENS_FINAL)) {
-    /* the coordinate names as a run's trajectory spells them */
-    if ((names = dm_traj_alloc(E->n, s->coords, DM_TRAJ_WITH_P, e)) == NULL) {
+    /* the coordinate and momentum names as a run's trajectory spells them */
+    if ((names = dm_run_traj_alloc(E->I0, e)) == NULL) {
       dm_traj_free(tr);
       return NULL;
     }
-    for (i = 1; st == DM_OK && i < 1 + 2 * E->n; i++)
+    for (i = 1; st == DM_OK && i < 1 + E->nq + E->n; i++)
       st = dm_traj_add_column(tr, dm_traj_colname(names, i), DM_TRAJ_DATA, NULL, 0, e);
     dm_traj_free(names);
   }
@@ -766,7 +771,7 @@ static int batch_starts(ens *E, dm_err *e)
     row[E->col_status] = DM_EINTR;      /* until it runs */
     memcpy(par, s->par, E->npar * sizeof *par);
     dm_err_clear(e);
-    st = E->o->start(E->o->start_ctx, member_of(E, j), E->q0 + (size_t)i * E->n,
+    st = E->o->start(E->o->start_ctx, member_of(E, j), E->q0 + (size_t)i * E->nq,
                      E->p0 + (size_t)i * E->n, E->o->params ? par : NULL, e);
     if (st != DM_OK) {
       if (e != NULL && e->msg[0] == '\0')
@@ -985,12 +990,13 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
   E.opt = I->opt;
   E.o = o;
   E.n = I->n;
+  E.nq = I->nq;
   E.npar = I->sys->npar;
   E.user = o->user != NULL;
   E.variational = (o->reduce & DM_ENS_VARIATIONAL) != 0;
   E.nvals = 1 + o->nuser + 1;
   if (o->reduce & DM_ENS_BIT(DM_ENS_FINAL))
-    E.nvals += 2 * E.n;
+    E.nvals += E.nq + E.n;
   for (t = DM_ENS_ENERGY_ERROR; t < DM_ENS_NREDUCERS; t++)
     E.nvals += (o->reduce & DM_ENS_BIT(t)) != 0;
   E.col_status = E.nvals - 1;
@@ -1012,14 +1018,14 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
     size_t nb = (size_t)(B < E.count ? B : E.count > 0 ? E.count : 1);
     E.rows = malloc(((size_t)E.count + 1) * E.nvals * sizeof *E.rows);
     E.msg = calloc((size_t)E.count + 1, sizeof *E.msg);
-    E.q0 = malloc((nb * (2 * E.n + E.npar) + 1) * sizeof *E.q0);
+    E.q0 = malloc((nb * (E.nq + E.n + E.npar) + 1) * sizeof *E.q0);
     E.traj = E.user ? calloc(nb, sizeof *E.traj) : NULL;
     E.w = calloc((size_t)E.nworkers, sizeof *E.w);
     if (E.rows == NULL || E.msg == NULL || E.q0 == NULL || (E.user && E.traj == NULL)
         || E.w == NULL) {
       st = dm_err_set(e, DM_ENOMEM, "out of memory for %ld members", E.count);
     } else {
-      E.p0 = E.q0 + nb * E.n;
+      E.p0 = E.q0 + nb * E.nq;
       E.par0 = E.p0 + nb * E.n;
     }
   }

@@ -27,11 +27,13 @@
  *
  * Built-in reducers, computed in the worker threads in C:
  *   final          q and p at the end: columns named like a trajectory's
- *                  ("x", ..., "p_x", ...)
+ *                  ("x", ..., "p_x", ...; for a system on a group the
+ *                  stored numbers of g and "mu1", ...)
  *   energy_error   max |E - E0| over the samples (every `every` steps and
  *                  the last), E = p.v - L
  *   min_distance   min over the samples of the Euclidean norm of the
- *                  coordinates flagged in `dist` (all when NULL)
+ *                  coordinates (the nq numbers of q) flagged in `dist`
+ *                  (all when NULL)
  *   megno          mean exponential growth of nearby orbits <Y> of the
  *                  step map: the tangent vector d_k = DPhi(x_{k-1}) d_{k-1}
  *                  through the exact step Jacobian (integrator.h), with
@@ -44,7 +46,8 @@
  *                  Lyapunov exponent
  * with d_0 = (1, ..., 1) / sqrt(2n).  The variational reducers take one
  * step Jacobian per step (integrators without an exact one use central
- * differences; constrained systems have none: DM_EUNSUP).
+ * differences; constrained systems and systems on groups have none:
+ * DM_EUNSUP).
  *
  * User reduction: with a `user` callback every member is run by dm_run
  * into a trajectory of its own (run.h: samples, energy column, metadata),
@@ -126,7 +129,8 @@ enum dm_ens_reducer {
 #define DM_ENS_MAX_MESSAGES 100   /* failure messages kept as metadata */
 #define DM_ENS_MAX_MEMBERS 1000000000000L   /* 10^12 members per call */
 
-/* Member k's start: q, p (n each); par (npar, preset to the system's
+/* Member k's start: q (nq numbers, system.h: n but on groups), p (n); par
+ * (npar, preset to the system's
  * values) only with opts.params.  Return DM_OK, or a status with e filled
  * to stop the ensemble. */
 typedef int (*dm_ens_start_fn)(void *ctx, long k, double *q, double *p, double *par,
@@ -148,7 +152,7 @@ typedef struct dm_ens_opts {
   int threads;                  /* >= 0 (0: automatic) */
   dm_run_opts run;              /* t0, h, nsteps | t_end, every, max_energy_error */
   unsigned reduce;              /* DM_ENS_BIT(...) of built-in reducers */
-  const unsigned char *dist;    /* n flags for min_distance (NULL: all) */
+  const unsigned char *dist;    /* nq flags for min_distance (NULL: all) */
   dm_ens_start_fn start;        /* required */
   void *start_ctx;
   int params;                   /* start writes parameters */

@@ -40,7 +40,11 @@ int dm_run_steps_to(double t0, double t_end, double h, long *nsteps, dm_err *e)
 
 dm_traj *dm_run_traj_alloc(const dm_integrator *I, dm_err *e)
 {
-  return dm_traj_alloc(I->n, I->sys->coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, e);
+  const dm_system *s = I->sys;
+  if (s->pnames != NULL || s->vnames != NULL || I->nq != I->n)
+    return dm_traj_alloc_state(I->nq, s->coords, I->n, s->pnames, s->vnames,
+                               DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, e);
+  return dm_traj_alloc(I->n, s->coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, e);
 }
 
 static double now(void)
@@ -66,9 +70,9 @@ typedef struct run {
   dm_run_opts *o;         /* the run's copy: nsteps is set when a run "until"
                            * reaches t_end */
   dm_traj *tr;
-  size_t n;
-  double *q, *p;          /* the caller's state, advanced in place */
-  double *v, *extra;      /* n; one value per extra column */
+  size_t n, nq;           /* velocities (momenta); numbers per configuration */
+  double *q, *p;          /* the caller's state (nq, n), advanced in place */
+  double *v, *extra, *J;  /* n; one value per extra column; the momentum map (n) */
   size_t next;            /* extra columns: energy (if any) then momenta */
   int have_v;             /* v holds the previous sample's velocity (a guess) */
   int check_E;            /* energy computed at every sample */
@@ -77,7 +81,7 @@ typedef struct run {
   size_t samples;
   int varstep;            /* the integrator keeps the physical time (I->t) */
   int until;              /* varstep run to t_end: nsteps unknown until reached */
-  double *q1, *p1;        /* n each: the step of an "until" run */
+  double *q1, *p1;        /* nq, n: the step of an "until" run */
   char t_text[DM_NUM_BUFSIZE], of_text[32];
 } run;
 
@@ -134,7 +138,7 @@ static int record(run *r, dm_err *e)
   double E = NAN;
   dm_err le;
   int st;
-  if (!finite_vec(r->q, n) || !finite_vec(r->p, n))
+  if (!finite_vec(r->q, r->nq) || !finite_vec(r->p, n))
     return dm_err_set(e, DM_EDIVERGED, "the state became non-finite (NaN or Inf) by step %ld"
                       "%s (t = %s): the run diverged", r->k, of_text(r), time_text(r, r->k));
   if ((st = dm_integrator_velocity(r->I, r->q, r->p, r->v, r->have_v, &le)) != DM_OK) {
@@ -148,9 +152,11 @@ static int record(run *r, dm_err *e)
     E = NAN;
   if (o->energy)
     r->extra[j++] = E;
+  if (o->momentum != NULL && r->I->sys->momentum_map != NULL)
+    r->I->sys->momentum_map(r->I->sys, r->q, r->p, r->J);
   for (i = 0; i < n; i++)
     if (o->momentum != NULL && o->momentum[i])
-      r->extra[j++] = r->p[i];
+      r->extra[j++] = r->I->sys->momentum_map != NULL ? r->J[i] : r->p[i];
   if (r->varstep)
     r->extra[j++] = r->I->dt;
   if ((st = dm_traj_append(r->tr, time_at(r, r->k), r->q, r->p, r->v, r->extra, &le)) != DM_OK)
@@ -186,7 +192,7 @@ static int record(run *r, dm_err *e)
 static int check_args(const dm_integrator *I, const double *q, const double *p,
                       const dm_run_opts *o, const dm_traj *tr, dm_err *e)
 {
-  size_t n = I->n;
+  size_t n = I->n, nq = I->nq;
   if (!isfinite(o->h) || o->h == 0.0)
     return dm_err_set(e, DM_EINVAL, "need a finite step h != 0");
   if (!isfinite(o->t0))
@@ -199,12 +205,12 @@ static int check_args(const dm_integrator *I, const double *q, const double *p,
     return dm_err_set(e, DM_EINVAL, "max_energy_error must be >= 0");
   if (o->piece < 0)
     return dm_err_set(e, DM_EINVAL, "need piece >= 0 (0: automatic)");
-  if (tr == NULL || dm_traj_ncoords(tr) != n
+  if (tr == NULL || dm_traj_ncoords(tr) != nq || dm_traj_nmomenta(tr) != n
       || (dm_traj_flags(tr) & (DM_TRAJ_WITH_P | DM_TRAJ_WITH_V)) != (DM_TRAJ_WITH_P | DM_TRAJ_WITH_V)
-      || dm_traj_len(tr) != 0 || dm_traj_ncols(tr) != 1 + 3 * n)
+      || dm_traj_len(tr) != 0 || dm_traj_ncols(tr) != 1 + nq + 2 * n)
     return dm_err_set(e, DM_EINVAL, "the trajectory must be empty, with %zu coordinates, "
-                      "p and v columns and no other (dm_run_traj_alloc)", n);
-  if (!finite_vec(q, n) || !finite_vec(p, n))
+                      "p and v columns and no other (dm_run_traj_alloc)", nq);
+  if (!finite_vec(q, nq) || !finite_vec(p, n))
     return dm_err_set(e, DM_EINVAL, "the initial state contains NaN or Inf");
   return DM_OK;
 }
@@ -218,7 +224,7 @@ static size_t held_samples(const dm_run_opts *o)
 
 size_t dm_run_bytes(const dm_integrator *I, const dm_run_opts *o)
 {
-  size_t cols = 1 + 3 * I->n + (o->energy ? 1 : 0);
+  size_t cols = 1 + I->nq + 2 * I->n + (o->energy ? 1 : 0);
   for (size_t i = 0; o->momentum != NULL && i < I->n; i++)
     cols += o->momentum[i] != 0;
   long nsteps = o->nsteps;
@@ -245,7 +251,10 @@ static int prepare(run *r, dm_err *e)
   for (i = 0; st == DM_OK && i < r->n; i++)
     if (o->momentum != NULL && o->momentum[i]) {
       char name[DM_TRAJ_NAME_MAX + 1];
-      snprintf(name, sizeof name, "%s%s", DM_TRAJ_MOMENTUM, dm_traj_coord(r->tr, i));
+      if (s->momentum_map != NULL)
+        snprintf(name, sizeof name, "%s%zu", DM_TRAJ_MOMENTUM, i + 1);
+      else
+        snprintf(name, sizeof name, "%s%s", DM_TRAJ_MOMENTUM, dm_traj_coord(r->tr, i));
       st = dm_traj_add_column(r->tr, name, DM_TRAJ_DIAG, NULL, 0, e);
     }
   /* variable physical steps: their lengths as a column */
@@ -261,6 +270,8 @@ static int prepare(run *r, dm_err *e)
     st = dm_traj_meta_set_number(r->tr, "h", o->h, e);
   if (st == DM_OK && r->I->order > 0)
     st = dm_traj_meta_set_number(r->tr, "order", r->I->order, e);
+  if (st == DM_OK && s->space != NULL)
+    st = dm_traj_meta_set(r->tr, "space", s->space, e);
   for (i = 0; st == DM_OK && i < s->npar; i++) {
     snprintf(key, sizeof key, "param.%s", s->params ? s->params[i] : "?");
     st = dm_traj_meta_set_number(r->tr, key, s->par[i], e);
@@ -323,7 +334,7 @@ static int advance_until(run *r, long end, dm_err *e)
     if (st != DM_OK)
       return dm_err_set(e, st, "step %ld from t = %s failed: %s", r->k + 1, time_text(r, r->k),
                         le.msg[0] ? le.msg : dm_strstatus(st));
-    memcpy(r->q, r->q1, n * sizeof *r->q);
+    memcpy(r->q, r->q1, r->nq * sizeof *r->q);
     memcpy(r->p, r->p1, n * sizeof *r->p);
     r->k++;
     if (reached) {
@@ -397,15 +408,17 @@ static int run_it(dm_integrator *I, double *q, double *p, const dm_run_opts *opt
   r.o = &o;
   r.tr = tr;
   r.n = I->n;
+  r.nq = I->nq;
   r.q = q;
   r.p = p;
   r.last = -1;
   r.check_E = o.energy || o.max_energy_error > 0;
-  if ((r.v = calloc(4 * r.n + 2, sizeof *r.v)) == NULL)
+  if ((r.v = calloc(5 * r.n + r.nq + 2, sizeof *r.v)) == NULL)
     return dm_err_set(e, DM_ENOMEM, "out of memory");
-  r.extra = r.v + r.n;
-  r.q1 = r.extra + r.n + 2;
-  r.p1 = r.q1 + r.n;
+  r.extra = r.v + r.n;            /* energy, n momenta, the step length */
+  r.J = r.extra + r.n + 2;
+  r.q1 = r.J + r.n;
+  r.p1 = r.q1 + r.nq;
   if ((st = dm_integrator_begin(I, o.h, o.t0, q, p, e)) != DM_OK) {
     free(r.v);
     return st;

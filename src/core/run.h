@@ -9,13 +9,19 @@
  * The run takes nsteps steps of h (or as many as reach t_end) from (t0, q,
  * p) with the integrator I and records a sample (t, q, p, v, diagnostics)
  * at step 0, every `every` steps and at the last step, with the times
- * t0 + k h.  Diagnostic columns, filled as the samples are recorded:
- * "energy" (E = p.v - L) and "momentum_<coord>" (p of the coordinates the
- * caller flags).  Metadata on the trajectory, numbers as numbers (see
- * trajectory.h): system, method, stages (when they are a choice:
- * dm_integrator_stages_chosen), h, order,
- * param.<name>; when the run ends: steps (completed), status (the DM_*
- * code, 0 for a complete run) and, for an early end, message.
+ * t0 + k h.  q holds the nq numbers of a configuration (system.h: nq; n
+ * but for systems on groups), p and v the n momenta and velocities, and
+ * the trajectory's columns are the same (dm_run_traj_alloc: the system's
+ * coordinate, momentum and velocity names).  Diagnostic columns, filled
+ * as the samples are recorded: "energy" (E = p.v - L) and
+ * "momentum_<coord>" (p of the coordinates the caller flags), or, for a
+ * system with a momentum map (the spatial momentum on a group),
+ * "momentum_<k>" = J_k(q, p) for the flagged k.  Metadata on the
+ * trajectory, numbers as numbers (see trajectory.h): system, method,
+ * stages (when they are a choice: dm_integrator_stages_chosen), h, order,
+ * space (system.h), param.<name>; when the run ends: steps (completed),
+ * status (the DM_* code, 0 for a complete run) and, for an early end,
+ * message.
  *
  * Variable physical steps.  With an integrator whose families keep the
  * physical time themselves (DM_INTEG_VARSTEP: time transformations,
@@ -128,7 +134,8 @@ int dm_run_steps_to(double t0, double t_end, double h, long *nsteps, dm_err *e);
  * columns, 8 bytes each), for a warning before memory runs out. */
 size_t dm_run_bytes(const dm_integrator *I, const dm_run_opts *o);
 
-/* An empty trajectory for runs of I: its coordinates, p and v columns. */
+/* An empty trajectory for runs of I: its coordinates (nq), p and v
+ * columns (n each). */
 dm_traj *dm_run_traj_alloc(const dm_integrator *I, dm_err *e);
 
 /* Run I from (q, p) into tr (empty, from dm_run_traj_alloc or of the same

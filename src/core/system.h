@@ -133,7 +133,28 @@ typedef struct dm_system {
   /* Bring what the filler derived from the parameters (a constant mass
    * matrix) up to date after par changed; NULL: nothing to do. */
   int (*refresh)(struct dm_system *, dm_err *);
+
+  /* Configurations stored in other numbers than the n velocities (a
+   * system on a Lie group: a rotation is 9 numbers, its body velocity 3).
+   * nq: numbers per configuration q (0: n; coords then names nq); p and v
+   * keep n.  pnames, vnames: n names of the momenta and velocities, the
+   * p and v columns of trajectories (NULL: "p_<coord>", "v_<coord>",
+   * only when nq is n).  space: the configuration space's name, recorded
+   * by runs as the metadata "space" (NULL: none).  momentum_map (NULL:
+   * none): a momentum map J(q, p) of n values (a group's spatial
+   * momentum) that runs record as "momentum_<k>" in place of p_k. */
+  size_t nq;
+  const char *const *pnames, *const *vnames;
+  const char *space;
+  void (*momentum_map)(const struct dm_system *, const double *q, const double *p,
+                       double *J);
 } dm_system;
+
+/* Numbers per configuration: sys->nq, or n when it is 0. */
+static inline size_t dm_system_nq(const dm_system *s)
+{
+  return s->nq != 0 ? s->nq : s->n;
+}
 
 /* Release what the system's filler owns (calls free_data) and zero *s.
  * NULL is a no-op. */

@@ -25,9 +25,11 @@ typedef struct meta {
 } meta;
 
 struct dm_traj {
-  size_t n;           /* coordinates */
+  size_t n;           /* coordinates (q columns) */
+  size_t np;          /* momenta: p and v columns each (n unless named apart) */
+  int named;          /* the p and v columns have their own names */
   unsigned flags;     /* DM_TRAJ_WITH_* */
-  size_t nstate;      /* 1 + n * (1 + has p + has v): first extra column */
+  size_t nstate;      /* 1 + n + np * (has p + has v): first extra column */
   column *cols;
   size_t ncols, colcap;
   size_t *hidx;       /* name hash index: slots hold column + 1, 0 empty; */
@@ -219,21 +221,56 @@ static int push_col(dm_traj *tr, const char *prefix, const char *name,
   return DM_OK;
 }
 
-dm_traj *dm_traj_alloc(size_t n, const char *const *coords, unsigned flags,
-                       dm_err *e)
+/* The q, p or v columns (pass 0, 1, 2): names from `names`, or the
+ * coordinates with the prefix, or "q1".. */
+static int push_state_cols(dm_traj *tr, int pass, size_t count, const char *const *names,
+                           const char *const *coords, dm_err *e)
 {
   static const char *const pre[3] = {"", "p_", "v_"};
   static const int kinds[3] = {DM_TRAJ_Q, DM_TRAJ_P, DM_TRAJ_V};
-  dm_traj *tr;
-  size_t i, pass;
+  static const char *const what[3] = {"coordinate", "momentum", "velocity"};
+  size_t i;
   int st = DM_OK;
+  for (i = 0; i < count && st == DM_OK; i++) {
+    char def[32];
+    const char *name = def;
+    const char *prefix = pre[pass];
+    if (names != NULL) {
+      name = names[i];
+      prefix = "";
+      if (!valid_name(name))
+        return bad_name(e, what[pass], name);
+    } else if (coords != NULL) {
+      name = coords[i];
+      if (!valid_name(name) || (pass == 0 && strlen(name) > DM_TRAJ_NAME_MAX - 2))
+        return bad_name(e, "coordinate", name);
+    } else {
+      snprintf(def, sizeof def, "q%zu", i + 1);
+    }
+    st = push_col(tr, prefix, name, kinds[pass], e);
+  }
+  return st;
+}
+
+dm_traj *dm_traj_alloc_state(size_t n, const char *const *coords, size_t np,
+                             const char *const *pnames, const char *const *vnames,
+                             unsigned flags, dm_err *e)
+{
+  dm_traj *tr;
+  int st = DM_OK, named = pnames != NULL || vnames != NULL;
 
   if (flags & ~(unsigned)(DM_TRAJ_WITH_P | DM_TRAJ_WITH_V)) {
     dm_err_set(e, DM_EINVAL, "trajectory: unknown flags 0x%x", flags);
     return NULL;
   }
-  if (n > 1000000) {
-    dm_err_set(e, DM_EINVAL, "trajectory: %zu coordinates is too many", n);
+  if (n > 1000000 || np > 1000000) {
+    dm_err_set(e, DM_EINVAL, "trajectory: %zu coordinates is too many", n > np ? n : np);
+    return NULL;
+  }
+  if ((!named && np != n) || (named && (((flags & DM_TRAJ_WITH_P) && pnames == NULL)
+                                         || ((flags & DM_TRAJ_WITH_V) && vnames == NULL)))) {
+    dm_err_set(e, DM_EINVAL, "trajectory: %zu momenta for %zu coordinates need the names of "
+               "their p and v columns", np, n);
     return NULL;
   }
   tr = calloc(1, sizeof *tr);
@@ -242,34 +279,28 @@ dm_traj *dm_traj_alloc(size_t n, const char *const *coords, unsigned flags,
     return NULL;
   }
   tr->n = n;
+  tr->np = np;
+  tr->named = named;
   tr->flags = flags;
   st = push_col(tr, "", "t", DM_TRAJ_T, e);
-  for (pass = 0; pass < 3 && st == DM_OK; pass++) {
-    if ((pass == 1 && !(flags & DM_TRAJ_WITH_P))
-        || (pass == 2 && !(flags & DM_TRAJ_WITH_V)))
-      continue;
-    for (i = 0; i < n && st == DM_OK; i++) {
-      char def[32];
-      const char *name = def;
-      if (coords != NULL) {
-        name = coords[i];
-        if (!valid_name(name)
-            || (pass == 0 && strlen(name) > DM_TRAJ_NAME_MAX - 2)) {
-          st = bad_name(e, "coordinate", name);
-          break;
-        }
-      } else {
-        snprintf(def, sizeof def, "q%zu", i + 1);
-      }
-      st = push_col(tr, pre[pass], name, kinds[pass], e);
-    }
-  }
+  if (st == DM_OK)
+    st = push_state_cols(tr, 0, n, NULL, coords, e);
+  if (st == DM_OK && (flags & DM_TRAJ_WITH_P))
+    st = push_state_cols(tr, 1, np, pnames, coords, e);
+  if (st == DM_OK && (flags & DM_TRAJ_WITH_V))
+    st = push_state_cols(tr, 2, np, vnames, coords, e);
   if (st != DM_OK) {
     dm_traj_free(tr);
     return NULL;
   }
   tr->nstate = tr->ncols;
   return tr;
+}
+
+dm_traj *dm_traj_alloc(size_t n, const char *const *coords, unsigned flags,
+                       dm_err *e)
+{
+  return dm_traj_alloc_state(n, coords, n, NULL, NULL, flags, e);
 }
 
 void dm_traj_free(dm_traj *tr)
@@ -363,7 +394,7 @@ void dm_traj_clear(dm_traj *tr)
 int dm_traj_append(dm_traj *tr, double t, const double *q, const double *p,
                    const double *v, const double *extra, dm_err *e)
 {
-  size_t i, j, k = tr->len, n = tr->n;
+  size_t i, j, k = tr->len, n = tr->n, np = tr->np;
   column *c;
   int st;
   if (n > 0 && q == NULL)
@@ -376,14 +407,14 @@ int dm_traj_append(dm_traj *tr, double t, const double *q, const double *p,
     c[1 + i].x[k] = q[i];
   j = 1 + n;
   if (tr->flags & DM_TRAJ_WITH_P) {
-    for (i = 0; i < n; i++)
+    for (i = 0; i < np; i++)
       c[j + i].x[k] = p != NULL ? p[i] : NAN;
-    j += n;
+    j += np;
   }
   if (tr->flags & DM_TRAJ_WITH_V) {
-    for (i = 0; i < n; i++)
+    for (i = 0; i < np; i++)
       c[j + i].x[k] = v != NULL ? v[i] : NAN;
-    j += n;
+    j += np;
   }
   for (i = 0; j + i < tr->ncols; i++)
     c[j + i].x[k] = extra != NULL ? extra[i] : NAN;
@@ -399,6 +430,8 @@ int dm_traj_sink(void *ctx, double t, const double *q, const double *p,
 
 size_t dm_traj_len(const dm_traj *tr) { return tr->len; }
 size_t dm_traj_ncoords(const dm_traj *tr) { return tr->n; }
+size_t dm_traj_nmomenta(const dm_traj *tr) { return tr->np; }
+int dm_traj_named_momenta(const dm_traj *tr) { return tr->named; }
 size_t dm_traj_ncols(const dm_traj *tr) { return tr->ncols; }
 unsigned dm_traj_flags(const dm_traj *tr) { return tr->flags; }
 
@@ -438,16 +471,16 @@ size_t dm_traj_qcol(const dm_traj *tr, size_t i)
 
 size_t dm_traj_pcol(const dm_traj *tr, size_t i)
 {
-  if (i >= tr->n || !(tr->flags & DM_TRAJ_WITH_P))
+  if (i >= tr->np || !(tr->flags & DM_TRAJ_WITH_P))
     return DM_TRAJ_NONE;
   return 1 + tr->n + i;
 }
 
 size_t dm_traj_vcol(const dm_traj *tr, size_t i)
 {
-  if (i >= tr->n || !(tr->flags & DM_TRAJ_WITH_V))
+  if (i >= tr->np || !(tr->flags & DM_TRAJ_WITH_V))
     return DM_TRAJ_NONE;
-  return tr->nstate - tr->n + i;
+  return tr->nstate - tr->np + i;
 }
 
 int dm_traj_get(const dm_traj *tr, size_t k, double *t, double *q, double *p,
@@ -459,10 +492,10 @@ int dm_traj_get(const dm_traj *tr, size_t k, double *t, double *q, double *p,
                       k, tr->len);
   if (t != NULL)
     *t = tr->cols[0].x[k];
-  for (i = 0; i < n; i++) {
+  for (i = 0; i < n && q != NULL; i++)
+    q[i] = tr->cols[1 + i].x[k];
+  for (i = 0; i < tr->np; i++) {
     size_t jp = dm_traj_pcol(tr, i), jv = dm_traj_vcol(tr, i);
-    if (q != NULL)
-      q[i] = tr->cols[1 + i].x[k];
     if (p != NULL)
       p[i] = jp != DM_TRAJ_NONE ? tr->cols[jp].x[k] : NAN;
     if (v != NULL)
@@ -621,10 +654,11 @@ static int derive_fill(const dm_traj *tr, size_t m, dm_traj_fn fn, void *ctx,
   dm_traj_sample s;
   size_t k, a, n = tr->n;
   s.n = n;
+  s.np = tr->np;
   s.row = row;
   s.q = row + 1;
   s.p = (tr->flags & DM_TRAJ_WITH_P) ? row + 1 + n : NULL;
-  s.v = (tr->flags & DM_TRAJ_WITH_V) ? row + tr->nstate - n : NULL;
+  s.v = (tr->flags & DM_TRAJ_WITH_V) ? row + tr->nstate - tr->np : NULL;
   s.extra = row + tr->nstate;
   s.traj = tr;
   for (k = 0; k < tr->len; k++) {
@@ -701,7 +735,7 @@ static int copy_meta(dm_traj *dst, const dm_traj *src, dm_err *e)
 dm_traj *dm_traj_slice(const dm_traj *tr, size_t i, size_t j, size_t stride,
                        dm_err *e)
 {
-  const char **coords = NULL;
+  const char **coords = NULL, **pn, **vn;
   dm_traj *s = NULL;
   size_t a, c, k, count;
   int st = DM_OK;
@@ -712,14 +746,24 @@ dm_traj *dm_traj_slice(const dm_traj *tr, size_t i, size_t j, size_t stride,
     return NULL;
   }
   count = (j - i + stride - 1) / stride;
-  coords = malloc((tr->n + 1) * sizeof *coords);
+  coords = malloc((tr->n + 2 * tr->np + 1) * sizeof *coords);
   if (coords == NULL) {
     dm_err_set(e, DM_ENOMEM, "slice: out of memory");
     return NULL;
   }
+  pn = coords + tr->n;
+  vn = pn + tr->np;
   for (a = 0; a < tr->n; a++)
     coords[a] = tr->cols[1 + a].name;
-  s = dm_traj_alloc(tr->n, coords, tr->flags, e);
+  for (a = 0; a < tr->np; a++) {
+    size_t jp = dm_traj_pcol(tr, a), jv = dm_traj_vcol(tr, a);
+    pn[a] = jp != DM_TRAJ_NONE ? tr->cols[jp].name : NULL;
+    vn[a] = jv != DM_TRAJ_NONE ? tr->cols[jv].name : NULL;
+  }
+  s = tr->named ? dm_traj_alloc_state(tr->n, coords, tr->np,
+                                      (tr->flags & DM_TRAJ_WITH_P) ? pn : NULL,
+                                      (tr->flags & DM_TRAJ_WITH_V) ? vn : NULL, tr->flags, e)
+                : dm_traj_alloc(tr->n, coords, tr->flags, e);
   free(coords);
   if (s == NULL)
     return NULL;

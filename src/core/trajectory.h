@@ -10,10 +10,14 @@
  * Column layout and names (fixed order):
  *   0                 "t"
  *   1 .. n            q columns, named after the coordinates ("r", "theta")
- *   then n            p columns "p_<coord>" ("p_r")       if DM_TRAJ_WITH_P
- *   then n            v columns "v_<coord>" ("v_r")       if DM_TRAJ_WITH_V
+ *   then np           p columns "p_<coord>" ("p_r")       if DM_TRAJ_WITH_P
+ *   then np           v columns "v_<coord>" ("v_r")       if DM_TRAJ_WITH_V
  *   then              extra columns in the order they were added
  * Without coordinate names the coordinates are called "q1", ..., "qn".
+ * Usually np = n.  A configuration stored in more numbers than it has
+ * velocities (a rotation: 9 entries, 3 angular velocities) has np < n
+ * momenta whose p and v columns carry their own names ("mu1", "xi1";
+ * dm_traj_alloc_state): a trajectory with "named momenta".
  * Diagnostic columns written by integrators are named DM_TRAJ_ENERGY
  * ("energy") and DM_TRAJ_MOMENTUM "<coord or name>" ("momentum_theta").
  * A column name is non-empty, at most DM_TRAJ_NAME_MAX bytes, contains no
@@ -89,6 +93,12 @@ enum { DM_TRAJ_REPLACE = 1u << 0 };
  * name, DM_ENOMEM. */
 dm_traj *dm_traj_alloc(size_t n, const char *const *coords, unsigned flags,
                        dm_err *e);
+/* The same with np momenta: pnames, vnames (np names each) name the p and v
+ * columns the flags ask for; both NULL: "p_<coord>", "v_<coord>" as
+ * dm_traj_alloc, which needs np == n. */
+dm_traj *dm_traj_alloc_state(size_t n, const char *const *coords, size_t np,
+                             const char *const *pnames, const char *const *vnames,
+                             unsigned flags, dm_err *e);
 void dm_traj_free(dm_traj *tr);
 
 /* Make room for `nsamples` samples in total (appends then never allocate
@@ -106,7 +116,7 @@ size_t dm_traj_bytes(const dm_traj *tr);
 
 /* ---- appending ------------------------------------------------------------- */
 
-/* Append one sample.  q: n values (required when n > 0).  p, v: n values or
+/* Append one sample.  q: n values (required when n > 0).  p, v: np values or
  * NULL; stored only when the trajectory has those columns, NULL then stores
  * NaN ("not available").  extra: one value per extra column in column order,
  * or NULL for NaN.  Storage grows by doubling; DM_ENOMEM keeps every sample
@@ -124,6 +134,8 @@ int dm_traj_sink(void *ctx, double t, const double *q, const double *p,
 
 size_t dm_traj_len(const dm_traj *tr);        /* samples */
 size_t dm_traj_ncoords(const dm_traj *tr);    /* n */
+size_t dm_traj_nmomenta(const dm_traj *tr);   /* np */
+int dm_traj_named_momenta(const dm_traj *tr); /* 1: p, v columns named apart */
 size_t dm_traj_ncols(const dm_traj *tr);      /* all columns, t included */
 unsigned dm_traj_flags(const dm_traj *tr);    /* DM_TRAJ_WITH_* */
 /* Name of coordinate i (< n); NULL when out of range. */
@@ -139,8 +151,9 @@ const char *dm_traj_kindname(int kind);
 
 /* Index of the column called `name`, or DM_TRAJ_NONE. */
 size_t dm_traj_find(const dm_traj *tr, const char *name);
-/* Index of the q / p / v column of coordinate i, or DM_TRAJ_NONE when i is
- * out of range or the trajectory does not store that kind. */
+/* Index of the q column of coordinate i (< n), of the p / v column of
+ * momentum i (< np), or DM_TRAJ_NONE when i is out of range or the
+ * trajectory does not store that kind. */
 size_t dm_traj_qcol(const dm_traj *tr, size_t i);
 size_t dm_traj_pcol(const dm_traj *tr, size_t i);
 size_t dm_traj_vcol(const dm_traj *tr, size_t i);
@@ -153,8 +166,8 @@ int dm_traj_lookup(const dm_traj *tr, const char *name, size_t *j, dm_err *e);
  * (truncated with "..." when it does not fit); returns buf. */
 char *dm_traj_names(const dm_traj *tr, char *buf, size_t size);
 
-/* Copy sample k into the caller's arrays (each may be NULL; p/v get NaN when
- * not stored).  DM_EINVAL when k >= len. */
+/* Copy sample k into the caller's arrays (each may be NULL; q gets n
+ * values, p and v np, NaN when not stored).  DM_EINVAL when k >= len. */
 int dm_traj_get(const dm_traj *tr, size_t k, double *t, double *q, double *p,
                 double *v, dm_err *e);
 /* Copy all ncols values of sample k into row.  DM_EINVAL when k >= len. */
@@ -181,10 +194,11 @@ typedef struct dm_traj_sample {
   size_t k;                 /* sample index, 0-based */
   double t;
   size_t n;                 /* coordinates */
-  const double *q, *p, *v;  /* n values each */
+  const double *q, *p, *v;  /* n, np, np values */
   const double *extra;      /* the extra columns that existed before the call */
   const double *row;        /* all columns */
   const dm_traj *traj;      /* for names (read only; do not modify) */
+  size_t np;                /* momenta */
 } dm_traj_sample;
 
 /* A derive callback writes m values to out (SUNDIALS convention: 0 success,
@@ -240,6 +254,10 @@ int dm_traj_meta_number_at(const dm_traj *tr, size_t i, double *x);
  *   # kinds t,q,q,p,p,v,v,diag,derived                      (one per column)
  *   t,r,theta,p_r,p_theta,v_r,v_theta,energy,x
  *   0,2,0,...                                               (%.17g)
+ * The p columns follow the q columns.  When the first is called "p_..."
+ * they must be "p_<coord>" for every coordinate (and the v columns
+ * "v_<coord>"); otherwise the file has named momenta (above): as many p
+ * columns as there are, each keeping its name, and as many v columns.
  * Version 1 files (no "# number" lines) load with every value a string.
  * dm_traj_load also reads a plain CSV whose first line is a header starting
  * with "t" (other '#' lines are skipped): every other column becomes a

@@ -388,12 +388,48 @@ static int twice(reader *r, char **names, size_t nc)
   return st;
 }
 
-/* Check the kinds against the header names: t, n q, [n p], [n v], extras. */
+/* The p (pass 1) or v (pass 2) columns from column *j on: "p_<coord>" for
+ * each of the n coordinates, or -- named momenta -- a run of columns of
+ * the kind with their own names (*np of them; a v run must match the p
+ * run).  *named: -1 not known yet, 0 standard, 1 named. */
+static int state_block(reader *r, char **names, const int *kind, size_t nc, size_t q0,
+                       size_t n, int pass, size_t *j, size_t *np, int *named)
+{
+  const char *pre = pass == 1 ? "p_" : "v_";
+  int k = pass == 1 ? DM_TRAJ_P : DM_TRAJ_V;
+  char want[DM_TRAJ_NAME_MAX + 8];
+  size_t i, start = *j;
+  if (*named < 0)
+    *named = strncmp(names[*j], pre, 2) != 0;
+  if (!*named) {
+    for (i = 0; i < n; i++, (*j)++) {
+      snprintf(want, sizeof want, "%s%s", pre, names[q0 + i]);
+      if (*j >= nc || kind[*j] != k || strcmp(names[*j], want) != 0)
+        return fail_at(r, pass == 1 ? "expected momentum column '%.140s' of kind p after "
+                       "the q columns%s" : "expected velocity column '%.140s' of kind v "
+                       "after the q and p columns%s", want, "");
+    }
+    *np = n;
+    return DM_OK;
+  }
+  while (*j < nc && kind[*j] == k)
+    (*j)++;
+  if (pass == 2 && *np != SIZE_MAX && *j - start != *np) {
+    char a[32], b[32];
+    snprintf(a, sizeof a, "%zu", *j - start);
+    snprintf(b, sizeof b, "%zu", *np);
+    return fail_at(r, "%s velocity columns of kind v for %s momentum columns of kind p", a, b);
+  }
+  *np = *j - start;
+  return DM_OK;
+}
+
+/* Check the kinds against the header names: t, n q, [np p], [np v],
+ * extras. */
 static int layout(reader *r, char **names, char **kinds, size_t nc,
-                  size_t *n, unsigned *flags, int *kind)
+                  size_t *n, size_t *np, int *named, unsigned *flags, int *kind)
 {
   size_t j, i, q0;
-  char want[DM_TRAJ_NAME_MAX + 8];
   for (i = 0; i < nc; i++) {
     kind[i] = kinds != NULL ? kind_of(kinds[i]) : (i == 0 ? DM_TRAJ_T : DM_TRAJ_DATA);
     if (kind[i] < 0)
@@ -412,25 +448,25 @@ static int layout(reader *r, char **names, char **kinds, size_t nc,
   for (q0 = j; j < nc && kind[j] == DM_TRAJ_Q; j++)
     ;
   *n = j - q0;
+  *np = SIZE_MAX;
+  *named = -1;
   *flags = 0;
   if (j < nc && kind[j] == DM_TRAJ_P) {
-    for (i = 0; i < *n; i++, j++) {
-      snprintf(want, sizeof want, "p_%s", names[q0 + i]);
-      if (j >= nc || kind[j] != DM_TRAJ_P || strcmp(names[j], want) != 0)
-        return fail_at(r, "expected momentum column '%.140s' of kind p after "
-                       "the q columns%s", want, "");
-    }
+    int st = state_block(r, names, kind, nc, q0, *n, 1, &j, np, named);
+    if (st != DM_OK)
+      return st;
     *flags |= DM_TRAJ_WITH_P;
   }
   if (j < nc && kind[j] == DM_TRAJ_V) {
-    for (i = 0; i < *n; i++, j++) {
-      snprintf(want, sizeof want, "v_%s", names[q0 + i]);
-      if (j >= nc || kind[j] != DM_TRAJ_V || strcmp(names[j], want) != 0)
-        return fail_at(r, "expected velocity column '%.140s' of kind v after "
-                       "the q and p columns%s", want, "");
-    }
+    int st = state_block(r, names, kind, nc, q0, *n, 2, &j, np, named);
+    if (st != DM_OK)
+      return st;
     *flags |= DM_TRAJ_WITH_V;
   }
+  if (*np == SIZE_MAX)
+    *np = *n;
+  if (*named < 0)
+    *named = 0;
   for (; j < nc; j++)
     if (kind[j] < DM_TRAJ_DIAG)
       return fail_at(r, "column '%.100s' of kind %s is out of place (order: "
@@ -442,9 +478,9 @@ static int layout(reader *r, char **names, char **kinds, size_t nc,
 /* Build the empty trajectory described by the header line and preamble. */
 static dm_traj *make_traj(reader *r, preamble *pr, size_t *ncols)
 {
-  size_t nc = count_fields(r->line), nk = 0, n = 0, i;
+  size_t nc = count_fields(r->line), nk = 0, n = 0, np = 0, i;
   char **names = malloc(nc * sizeof *names), **kinds = NULL;
-  int *kind = malloc(nc * sizeof *kind);
+  int *kind = malloc(nc * sizeof *kind), named = 0;
   unsigned flags = 0;
   dm_traj *tr = NULL;
   int st;
@@ -471,10 +507,16 @@ static dm_traj *make_traj(reader *r, preamble *pr, size_t *ncols)
     fail_at(r, "expected a '# kinds' line before the header%s%s", "", "");
     goto done;
   }
-  if (layout(r, names, kinds, nc, &n, &flags, kind) != DM_OK)
+  if (layout(r, names, kinds, nc, &n, &np, &named, &flags, kind) != DM_OK)
     goto done;
-  tr = dm_traj_alloc(n, (const char *const *)names + 1, flags, r->e);
-  for (i = 1 + n * (1 + !!(flags & DM_TRAJ_WITH_P) + !!(flags & DM_TRAJ_WITH_V));
+  {
+    const char *const *cn = (const char *const *)names;
+    size_t jp = 1 + n, jv = jp + ((flags & DM_TRAJ_WITH_P) ? np : 0);
+    tr = named ? dm_traj_alloc_state(n, cn + 1, np, (flags & DM_TRAJ_WITH_P) ? cn + jp : NULL,
+                                     (flags & DM_TRAJ_WITH_V) ? cn + jv : NULL, flags, r->e)
+               : dm_traj_alloc(n, cn + 1, flags, r->e);
+  }
+  for (i = 1 + n + np * (!!(flags & DM_TRAJ_WITH_P) + !!(flags & DM_TRAJ_WITH_V));
        tr != NULL && i < nc; i++)
     if ((st = dm_traj_add_column(tr, names[i], kind[i], NULL, 0, r->e)) != DM_OK) {
       dm_traj_free(tr);
@@ -542,7 +584,7 @@ static int parse_row(reader *r, const dm_traj *tr, size_t nc, double *row)
 static int read_rows(reader *r, dm_traj *tr, size_t nc)
 {
   double *row = malloc(nc * sizeof *row);
-  size_t n = dm_traj_ncoords(tr), j;
+  size_t n = dm_traj_ncoords(tr), np = dm_traj_nmomenta(tr), j;
   const double *q = row + 1, *p = NULL, *v = NULL;
   int got, st = DM_OK;
   if (row == NULL)
@@ -550,11 +592,11 @@ static int read_rows(reader *r, dm_traj *tr, size_t nc)
   j = 1 + n;
   if (dm_traj_flags(tr) & DM_TRAJ_WITH_P) {
     p = row + j;
-    j += n;
+    j += np;
   }
   if (dm_traj_flags(tr) & DM_TRAJ_WITH_V) {
     v = row + j;
-    j += n;
+    j += np;
   }
   while (st == DM_OK && (got = next_line(r)) > 0) {
     if ((r->lineno % POLL_EVERY == 0 || nc > 256) && dm_interrupted())

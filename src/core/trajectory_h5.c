@@ -583,10 +583,11 @@ static long find_col(const reader *r, const char *name, int kind)
 /* The trajectory from the columns read: t, q, [p], [v], the rest extra. */
 static dm_traj *build(reader *r)
 {
-  size_t n = 0, j, i, k, ne = 0;
+  size_t n = 0, np = 0, nv = 0, m, j, i, k, ne = 0;
   long jt = find_col(r, "t", -1), *jq = NULL, *jp = NULL, *jv = NULL, *je = NULL;
   unsigned flags = 0;
-  const char **coords = NULL;
+  const char **coords = NULL, **pnames, **vnames;
+  int named = 0;
   double *buf = NULL;
   dm_traj *tr = NULL;
   char want[DM_TRAJ_NAME_MAX + 8];
@@ -596,46 +597,78 @@ static dm_traj *build(reader *r)
                jt >= 0 ? " of kind t" : "");
     return NULL;
   }
-  for (j = 0; j < r->ncols; j++)
+  for (j = 0; j < r->ncols; j++) {
     n += r->cols[j].kind == DM_TRAJ_Q;
+    np += r->cols[j].kind == DM_TRAJ_P;
+    nv += r->cols[j].kind == DM_TRAJ_V;
+  }
+  m = n > np ? n : np;
+  m = m > nv ? m : nv;
   jq = calloc(n + 1, sizeof *jq);
-  jp = calloc(n + 1, sizeof *jp);
-  jv = calloc(n + 1, sizeof *jv);
+  jp = calloc(m + 1, sizeof *jp);
+  jv = calloc(m + 1, sizeof *jv);
   je = calloc(r->ncols + 1, sizeof *je);
-  coords = calloc(n + 1, sizeof *coords);
-  buf = calloc(3 * n + r->ncols + 1, sizeof *buf);
+  coords = calloc(n + 2 * m + 1, sizeof *coords);
+  buf = calloc(n + 2 * m + r->ncols + 1, sizeof *buf);
   if (jq == NULL || jp == NULL || jv == NULL || je == NULL || coords == NULL || buf == NULL) {
     dm_err_set(r->e, DM_ENOMEM, "reading '%.200s': out of memory", r->path);
     goto done;
   }
+  pnames = coords + n;
+  vnames = pnames + m;
   for (j = 0, i = 0; j < r->ncols; j++)
     if (r->cols[j].kind == DM_TRAJ_Q) {
       jq[i] = (long)j;
       coords[i++] = r->cols[j].name;
     }
-  for (i = 0; i < n; i++) {
-    snprintf(want, sizeof want, "p_%s", coords[i]);
-    jp[i] = find_col(r, want, DM_TRAJ_P);
-    snprintf(want, sizeof want, "v_%s", coords[i]);
-    jv[i] = find_col(r, want, DM_TRAJ_V);
-  }
-  for (k = 0; k < 2; k++) {
-    long *jj = k == 0 ? jp : jv;
-    size_t have = 0, total = 0;
-    for (i = 0; i < n; i++)
-      have += jj[i] >= 0;
-    for (j = 0; j < r->ncols; j++)
-      total += r->cols[j].kind == (k == 0 ? DM_TRAJ_P : DM_TRAJ_V);
-    if (total > 0 && (have != n || total != n)) {
-      dm_err_set(r->e, DM_EINVAL, "reading '%.200s': the %s columns do not match the "
-                 "coordinates (expected %s_<coordinate> for each of the %zu)", r->path,
-                 k == 0 ? "momentum" : "velocity", k == 0 ? "p" : "v", n);
+  /* named momenta: the p (v) columns do not start with "p_" ("v_") */
+  for (j = 0; j < r->ncols && !named; j++)
+    named = (r->cols[j].kind == DM_TRAJ_P && strncmp(r->cols[j].name, "p_", 2) != 0)
+            || (r->cols[j].kind == DM_TRAJ_V && strncmp(r->cols[j].name, "v_", 2) != 0);
+  if (named) {
+    size_t a = 0, b = 0;
+    if (np > 0 && nv > 0 && np != nv) {
+      dm_err_set(r->e, DM_EINVAL, "reading '%.200s': %zu velocity columns for %zu momentum "
+                 "columns", r->path, nv, np);
       goto done;
     }
-    if (total > 0)
-      flags |= k == 0 ? DM_TRAJ_WITH_P : DM_TRAJ_WITH_V;
+    for (j = 0; j < r->ncols; j++)
+      if (r->cols[j].kind == DM_TRAJ_P) {
+        jp[a] = (long)j;
+        pnames[a++] = r->cols[j].name;
+      } else if (r->cols[j].kind == DM_TRAJ_V) {
+        jv[b] = (long)j;
+        vnames[b++] = r->cols[j].name;
+      }
+    np = np > 0 ? np : nv;
+    flags = (a > 0 ? DM_TRAJ_WITH_P : 0u) | (b > 0 ? DM_TRAJ_WITH_V : 0u);
+  } else {
+    for (i = 0; i < n; i++) {
+      snprintf(want, sizeof want, "p_%s", coords[i]);
+      jp[i] = find_col(r, want, DM_TRAJ_P);
+      snprintf(want, sizeof want, "v_%s", coords[i]);
+      jv[i] = find_col(r, want, DM_TRAJ_V);
+    }
+    for (k = 0; k < 2; k++) {
+      long *jj = k == 0 ? jp : jv;
+      size_t have = 0, total = k == 0 ? np : nv;
+      for (i = 0; i < n; i++)
+        have += jj[i] >= 0;
+      if (total > 0 && (have != n || total != n)) {
+        dm_err_set(r->e, DM_EINVAL, "reading '%.200s': the %s columns do not match the "
+                   "coordinates (expected %s_<coordinate> for each of the %zu)", r->path,
+                   k == 0 ? "momentum" : "velocity", k == 0 ? "p" : "v", n);
+        goto done;
+      }
+      if (total > 0)
+        flags |= k == 0 ? DM_TRAJ_WITH_P : DM_TRAJ_WITH_V;
+    }
+    np = n;
   }
-  if ((tr = dm_traj_alloc(n, coords, flags, r->e)) == NULL)
+  tr = named ? dm_traj_alloc_state(n, coords, np, (flags & DM_TRAJ_WITH_P) ? pnames : NULL,
+                                   (flags & DM_TRAJ_WITH_V) ? vnames : NULL, flags, r->e)
+             : dm_traj_alloc(n, coords, flags, r->e);
+  if (tr == NULL)
     goto done;
   for (j = 0; j < r->ncols && st == DM_OK; j++) {
     int kd = r->cols[j].kind;
@@ -656,9 +689,10 @@ static dm_traj *build(reader *r)
   if (st == DM_OK)
     st = dm_traj_reserve(tr, r->len, r->e);
   for (k = 0; k < r->len && st == DM_OK; k++) {
-    double *q = buf, *p = q + n, *v = p + n, *x = v + n;
-    for (i = 0; i < n; i++) {
+    double *q = buf, *p = q + n, *v = p + np, *x = v + np;
+    for (i = 0; i < n; i++)
       q[i] = r->cols[jq[i]].x[k];
+    for (i = 0; i < np; i++) {
       p[i] = flags & DM_TRAJ_WITH_P ? r->cols[jp[i]].x[k] : NAN;
       v[i] = flags & DM_TRAJ_WITH_V ? r->cols[jv[i]].x[k] : NAN;
     }

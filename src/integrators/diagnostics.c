@@ -39,6 +39,10 @@ int dm_integrator_jacobian(dm_integrator *I, double h, const double *q0,
   if (I->m > 0)
     return dm_err_set(e, DM_EUNSUP, "the step Jacobian in the containing space is not defined for "
                       "constrained systems");
+  if (I->nq != I->n)
+    return dm_err_set(e, DM_EUNSUP, "the step Jacobian in coordinates is not defined for a "
+                      "configuration stored in %zu numbers with %zu velocities (a system on a "
+                      "group has its own diagnostics)", I->nq, I->n);
   if (I->type->jacobian != NULL && (I->flags & DM_INTEG_EXACT_JAC))
     return I->type->jacobian(I, h, q0, p0, DPhi, e);
   return jacobian_fd(I, h, q0, p0, DPhi, e);
@@ -81,6 +85,10 @@ int dm_integrator_reversal(dm_integrator *I, double h, long n, const double *q0,
   double *q = I->scratch + 4 * d, *p = q + d;
   long k;
   int st;
+  if (I->nq != d)
+    return dm_err_set(e, DM_EUNSUP, "reversal in coordinates is not defined for a configuration "
+                      "stored in %zu numbers with %zu velocities (a system on a group has its "
+                      "own diagnostics)", I->nq, d);
   memcpy(q, q0, d * sizeof(double));
   memcpy(p, p0, d * sizeof(double));
   for (k = 0; k < 2 * n; k++)

@@ -203,6 +203,7 @@ int dm_integrator_new(const dm_system *sys, const char *method,
   I->type = type;
   I->sys = sys;
   I->n = n;
+  I->nq = dm_system_nq(sys);
   I->m = sys->m;
   if (opts)
     I->opt = *opts;
@@ -215,7 +216,7 @@ int dm_integrator_new(const dm_system *sys, const char *method,
   }
   if (variant)
     strcpy(I->variant, variant);
-  I->scratch = calloc(8 * n, sizeof(double));
+  I->scratch = calloc(9 * n + I->nq, sizeof(double));
   I->leg = dm_legendre_alloc(sys);
   if (I->scratch == NULL || I->leg == NULL) {
     dm_integrator_free(I);
@@ -277,7 +278,7 @@ int dm_integrator_step(dm_integrator *I, double h, const double *q0, const doubl
     return st;
   if ((st = I->type->step(I, h, q0, p0, q1, p1, e)) != DM_OK)
     return st;
-  if (!finite_vec(q1, I->n) || !finite_vec(p1, I->n))
+  if (!finite_vec(q1, I->nq) || !finite_vec(p1, I->n))
     return dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
   if (!dm_integrator_varstep(I)) {
     I->t += h;
@@ -420,8 +421,8 @@ static int emit(dm_integrator *I, dm_sink_fn sink, void *ctx, double t, const do
 static int advance_steps(dm_integrator *I, double h, long nsteps, double *q, double *p,
                          long *done, dm_err *e)
 {
-  size_t n = I->n;
-  double *q1 = I->scratch, *p1 = I->scratch + n;
+  size_t n = I->n, nq = I->nq;
+  double *q1 = I->scratch + 8 * n, *p1 = q1 + nq;   /* beyond the 8n of the others */
   long k;
   int st = DM_OK;
   for (k = 0; k < nsteps; k++) {
@@ -431,7 +432,7 @@ static int advance_steps(dm_integrator *I, double h, long nsteps, double *q, dou
     }
     if ((st = dm_integrator_step(I, h, q, p, q1, p1, e)) != DM_OK)
       break;
-    memcpy(q, q1, n * sizeof(double));
+    memcpy(q, q1, nq * sizeof(double));
     memcpy(p, p1, n * sizeof(double));
   }
   *done = k;
@@ -460,7 +461,7 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
                     "every >= 1 (got %ld)", h, nsteps, every);
     goto done;
   }
-  if (!finite_vec(q, n) || !finite_vec(p, n)) {
+  if (!finite_vec(q, I->nq) || !finite_vec(p, n)) {
     st = dm_err_set(e, DM_EDOM, "run: the initial state contains NaN or Inf");
     goto done;
   }

@@ -194,7 +194,8 @@ typedef struct dm_integ_stats {
 struct dm_integrator {
   const dm_integrator_type *type;
   const dm_system *sys;            /* borrowed */
-  size_t n, m;                     /* coordinates, constraints */
+  size_t n, m;                     /* coordinates (velocities, momenta), constraints */
+  size_t nq;                       /* numbers per configuration q (dm_system_nq) */
   dm_integ_opts opt;               /* private copy (tableau copied into state) */
   char variant[DM_INTEG_STRMAX];   /* text after "name:" (gsl stepper) */
   char name[2 * DM_INTEG_STRMAX];  /* full method name as requested */
@@ -211,7 +212,7 @@ struct dm_integrator {
   int begun;                       /* begin() ran since new() or reset */
   void *state;                     /* family private */
   struct dm_legendre_ws *leg;      /* Legendre-map workspace (velocity solves) */
-  double *scratch;                 /* 8n doubles for the generic layer */
+  double *scratch;                 /* 8n + nq + n doubles for the generic layer */
 };
 
 /* {==== registry and life cycle ========================================== */

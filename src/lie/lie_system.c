@@ -467,6 +467,13 @@ static int alloc_from(dm_expr_ctx *ctx, const dm_lie_spec *sp, dm_lie_system **o
   return DM_OK;
 }
 
+/* the momentum map of left translations, for the run driver's momentum
+ * columns */
+static void spatial_momentum(const dm_system *sys, const double *g, const double *mu, double *J)
+{
+  dm_lie_spatial_momentum(((const dm_lie_system *)sys->data)->G, g, mu, J);
+}
+
 static void fill_base(dm_lie_system *S)
 {
   dm_system *sys = &S->sys;
@@ -474,8 +481,13 @@ static void fill_base(dm_lie_system *S)
   sys->name = S->name;
   sys->kind = DM_SYSTEM_LIE;
   sys->n = S->dim;
+  sys->nq = S->nq;
   sys->npar = S->npar;
-  sys->coords = (const char *const *)S->xinames;
+  sys->coords = (const char *const *)S->gnames;
+  sys->pnames = (const char *const *)S->munames;
+  sys->vnames = (const char *const *)S->xinames;
+  sys->space = S->G->name;
+  sys->momentum_map = spatial_momentum;
   sys->params = (const char *const *)S->pnames;
   sys->par = S->parv;
   sys->flags = S->quadratic ? DM_SYS_MECHANICAL : 0;

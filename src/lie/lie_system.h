@@ -10,8 +10,9 @@
  * body frame for SE(3)).  dm_lie_system_compile derives, exactly, from the
  * expressions of L and F: the body momentum mu = dL/dxi and the
  * left-trivialized derivatives in g, compiles them (tape, or native code),
- * and exposes the result as a dm_system of kind DM_SYSTEM_LIE (n = dim;
- * q holds the nq numbers of g, v = xi, p = mu; Lq is the left-trivialized
+ * and exposes the result as a dm_system of kind DM_SYSTEM_LIE (n = dim,
+ * nq = the group's stored numbers: q holds the nq numbers of g, v = xi,
+ * p = mu; Lq is the left-trivialized
  * derivative (d/de) L(g exp(e e_k), xi), Lvq and Lqq the left-trivialized
  * derivatives of Lv and Lq) so that the integrator layer's Legendre maps,
  * energy and registry serve it unchanged.
@@ -147,27 +148,15 @@ int dm_lie_reversal(dm_integrator *I, double h, long n, const double *g0, const 
 
 /* {==== runs ============================================================= */
 
-/* Run I from (g, mu) into a new trajectory: nsteps steps of h (or to t_end
- * when nsteps < 0), recording step 0, every `every` steps and the last.
- * Columns: t, the stored numbers of g (coordinates, named by
- * dm_lie_system_gnames), then mu1.., xi1.. (data), energy and
- * momentum_1.. (the spatial momentum; diagnostics).  Metadata: system,
- * method, stages, h, order, space (the group's name, for
- * dm_lie_traj_group), reduced, param.<name>, and at the end steps,
- * status, message.  Early ends (Ctrl-C: DM_EINTR, a failed step, a
- * non-finite state) keep the samples so far, record the last good state
- * and return the status with a message counting steps from the start;
- * g and mu hold the last good state.  *out is NULL only on argument errors
- * (DM_EINVAL) or DM_ENOMEM before the first sample. */
-typedef struct dm_lie_run_opts {
-  double t0, h, t_end;
-  long nsteps, every;
-} dm_lie_run_opts;
+/* Runs are the core run driver's (core/run.h: dm_run_traj_alloc, dm_run)
+ * on the integrator: the system's dm_system declares nq stored numbers per
+ * configuration, so a trajectory has the columns t, the stored numbers of
+ * g (coordinates, named by dm_lie_system_gnames), mu1.. (p), xi1.. (v),
+ * energy and, when the momentum columns are asked for, momentum_1.. =
+ * the spatial momentum (the system's momentum map); the metadata "space"
+ * names the group. */
 
-int dm_lie_run(dm_integrator *I, double *g, double *mu, const dm_lie_run_opts *o,
-               dm_traj **out, dm_err *e);
-
-/* The group element of sample k of a trajectory written by dm_lie_run (or
+/* The group element of sample k of a trajectory of a run (or
  * loaded from its file): G from the "space" metadata (caller frees), the
  * stored numbers from the coordinate columns.  DM_EINVAL when the
  * trajectory has no "space" or its coordinates do not fit. */

@@ -24,6 +24,7 @@
 #include <gsl/gsl_rng.h>
 
 #include "lua/l_integ.h"
+#include "lua/l_lie_sys.h"
 #include "core/ensemble.h"
 #include "core/interrupt.h"
 #include "core/mpi.h"
@@ -137,8 +138,10 @@ enum { A_OPTS = 1, A_INTEG, A_STATES, A_PARAMS, A_REDUCE, A_RNG, A_NAMES, A_ERR,
 
 typedef struct call {
   lua_State *L;
-  dm_linteg *li;
-  dm_lsystem *ls;
+  dm_linteg *li;             /* an integrator of a Lagrangian system, or NULL */
+  dm_lsystem *ls;            /* its system */
+  dm_integrator *I;          /* the integrator */
+  const dm_lie_system *lie;  /* or the system on a group of a Lie integrator */
   long members;
   int states_fn, params_fn, have_params;
   unsigned long seed;
@@ -211,6 +214,13 @@ static int start_body(lua_State *L)
   }
   member_value(L, c, A_STATES, c->states_fn, "states");
   snprintf(fname, sizeof fname, "dm.ensemble: state of member %ld", c->k + 1);
+  if (c->lie != NULL) {
+    dm_lstate_lie g;
+    dm_lua_lie_readstate(L, c->I, c->lie, -1, fname, &g);
+    memcpy(c->q, g.g, c->I->nq * sizeof *c->q);
+    memcpy(c->p, g.mu, c->I->n * sizeof *c->p);
+    return 0;
+  }
   /* the system's own converter: the Legendre map needs no method, and the
    * integrator is left alone (a parameter change would rebuild it) */
   dm_lua_readstate(L, ls, ls->conv, -1, fname, c->buf, &s);
@@ -224,6 +234,8 @@ static void restore_params(call *c)
 {
   size_t i;
   int changed = 0;
+  if (c->ls == NULL)
+    return;
   for (i = 0; i < c->ls->npar; i++)
     if (memcmp(&c->ls->sys.par[i], &c->saved_par[i], sizeof(double)) != 0) {
       c->ls->sys.par[i] = c->saved_par[i];
@@ -403,7 +415,7 @@ static int list_or_function(lua_State *L, const char *key, int slot)
 }
 
 /* run = {t = | steps =, every =, h =, max_energy_error =} */
-static void read_run(lua_State *L, dm_linteg *li, dm_run_opts *r)
+static void read_run(lua_State *L, double h, dm_run_opts *r)
 {
   int has_t, has_steps, o;
   lua_Integer k;
@@ -412,7 +424,7 @@ static void read_run(lua_State *L, dm_linteg *li, dm_run_opts *r)
                "expected, got %s", luaL_typename(L, -1));
   o = lua_gettop(L);
   check_keys(L, o, run_keys, "run option");
-  r->h = li->h;
+  r->h = h;
   if (lua_getfield(L, o, "h") != LUA_TNIL) {
     r->h = lua_tonumber(L, -1);
     if (lua_type(L, -1) != LUA_TNUMBER || r->h == 0.0 || !isfinite(r->h))
@@ -515,10 +527,25 @@ static void push_names_array(lua_State *L, size_t n, const char **names)
   }
 }
 
+/* The coordinate called name (nq of them), or -1. */
+static long coord_index(const dm_integrator *I, const dm_lsystem *ls, const char *name)
+{
+  size_t i;
+  if (ls != NULL)
+    return dm_lua_system_coord(ls, name);
+  for (i = 0; I->sys->coords != NULL && i < I->nq; i++)
+    if (strcmp(I->sys->coords[i], name) == 0)
+      return (long)i;
+  return -1;
+}
+
 static int l_ensemble(lua_State *L)
 {
-  dm_linteg *li;
-  dm_lsystem *ls;
+  dm_linteg *li = NULL;
+  dm_lsystem *ls = NULL;
+  dm_integrator *I;
+  const dm_lie_system *lie = NULL;
+  double h;
   call *c;
   dm_ens_opts o;
   dm_ens_summary sum;
@@ -539,13 +566,17 @@ static int l_ensemble(lua_State *L)
   if (lua_getfield(L, A_OPTS, "integrator") == LUA_TNIL)
     return luaL_error(L, "dm.ensemble: integrator = (a dm.integrator) is required");
   lua_replace(L, A_INTEG);
-  if (luaL_testudata(L, A_INTEG, DM_INTEG_MT) == NULL) {
-    const char *got = luaL_getmetafield(L, A_INTEG, "__name") == LUA_TSTRING
-                      ? lua_tostring(L, -1) : luaL_typename(L, A_INTEG);
-    return luaL_error(L, "dm.ensemble: integrator must be a dm.integrator, got %s", got);
+  if ((I = dm_lua_lie_tointeg(L, A_INTEG, &lie, &h)) == NULL) {
+    if (luaL_testudata(L, A_INTEG, DM_INTEG_MT) == NULL) {
+      const char *got = luaL_getmetafield(L, A_INTEG, "__name") == LUA_TSTRING
+                        ? lua_tostring(L, -1) : luaL_typename(L, A_INTEG);
+      return luaL_error(L, "dm.ensemble: integrator must be a dm.integrator, got %s", got);
+    }
+    li = dm_linteg_check(L, A_INTEG);
+    ls = li->ls;
+    I = li->I;
+    h = li->h;
   }
-  li = dm_linteg_check(L, A_INTEG);
-  ls = li->ls;
   nstates = list_or_function(L, "states", A_STATES);
   if (nstates == 0)
     return luaL_error(L, "dm.ensemble: states = (a list of states, or a function(k, rng) "
@@ -559,6 +590,9 @@ static int l_ensemble(lua_State *L)
     return luaL_error(L, "dm.ensemble: states lists %d states for %d members",
                       (int)lua_rawlen(L, A_STATES), (int)members);
   st = list_or_function(L, "params", A_PARAMS);
+  if (st != 0 && lie != NULL)
+    return luaL_error(L, "dm.ensemble: params are not supported for a system on a group (its "
+                      "integrators read the system's own parameters: set them with sys:param)");
   if (st == 1 && (lua_Integer)lua_rawlen(L, A_PARAMS) < members)
     return luaL_error(L, "dm.ensemble: params lists %d tables for %d members",
                       (int)lua_rawlen(L, A_PARAMS), (int)members);
@@ -575,7 +609,7 @@ static int l_ensemble(lua_State *L)
     show = lua_toboolean(L, -1);
   lua_pop(L, 1);
   dm_ens_opts_init(&o);
-  read_run(L, li, &o.run);
+  read_run(L, h, &o.run);
   o.reduce = read_reduce(L, &user, &nuser);
   /* distance = {"x", "y"}: the coordinates of min_distance */
   if (lua_getfield(L, A_OPTS, "distance") != LUA_TNIL) {
@@ -584,16 +618,16 @@ static int l_ensemble(lua_State *L)
       return luaL_error(L, "dm.ensemble: distance applies to the min_distance reducer");
     if (lua_type(L, -1) != LUA_TTABLE || (len = lua_rawlen(L, -1)) == 0)
       return luaL_error(L, "dm.ensemble: distance must be a list of coordinate names");
-    dist = lua_newuserdatauv(L, ls->n, 0);
-    memset(dist, 0, ls->n);
+    dist = lua_newuserdatauv(L, I->nq, 0);
+    memset(dist, 0, I->nq);
     for (i = 1; i <= len; i++) {
       long j = -1;
       lua_rawgeti(L, -2, (lua_Integer)i);
-      if (lua_type(L, -1) != LUA_TSTRING || (j = dm_lua_system_coord(ls, lua_tostring(L, -1))) < 0) {
+      if (lua_type(L, -1) != LUA_TSTRING || (j = coord_index(I, ls, lua_tostring(L, -1))) < 0) {
         const char *bad = dm_tolstring(L, -1, NULL);
         return luaL_error(L, "dm.ensemble: distance[%d]: no coordinate %s in system '%s' "
-                          "(coordinates: %s)", (int)i, bad, ls->sys.name,
-                          dm_lsystem_names(L, ls->sys.coords, ls->n));
+                          "(coordinates: %s)", (int)i, bad, I->sys->name,
+                          dm_lsystem_names(L, I->sys->coords, I->nq));
       }
       dist[j] = 1;
       lua_pop(L, 1);
@@ -603,14 +637,16 @@ static int l_ensemble(lua_State *L)
   /* everything the call needs lives in Lua userdata: an error frees it */
   c = lua_newuserdatauv(L, sizeof *c, 0);
   memset(c, 0, sizeof *c);
-  c->buf = lua_newuserdatauv(L, (4 * ls->n + ls->npar + 1) * sizeof(double), 0);
-  c->saved_par = c->buf + 4 * ls->n;
-  memcpy(c->saved_par, ls->sys.par, ls->npar * sizeof(double));
+  c->buf = lua_newuserdatauv(L, (4 * I->nq + I->sys->npar + 1) * sizeof(double), 0);
+  c->saved_par = c->buf + 4 * I->nq;
+  memcpy(c->saved_par, I->sys->par, I->sys->npar * sizeof(double));
   names = lua_newuserdatauv(L, (nuser + 1) * sizeof *names, 0);
   push_names_array(L, nuser, names);
   c->L = L;
   c->li = li;
   c->ls = ls;
+  c->I = I;
+  c->lie = lie;
   c->members = (long)members;
   c->states_fn = nstates == 2;
   c->params_fn = st == 2;
@@ -642,7 +678,7 @@ static int l_ensemble(lua_State *L)
   o.distributed = 1;
   o.output = output;
   slot = dm_newtraj(L);                 /* the result's home, before anything is allocated */
-  st = dm_ensemble_run(li->I, &o, slot, &sum, &e);
+  st = dm_ensemble_run(I, &o, slot, &sum, &e);
   if (c->shown) {
     fprintf(stderr, "\r%90s\r", "");
     fflush(stderr);

@@ -4,7 +4,9 @@
  * l_integ_run.c (integ:run: the chunked C run loop, progress, trajectory
  * and diagnostic columns) and l_integ_diag.c (dm.tableau,
  * integ:order_estimate, dm.methods); l_ensemble.c (dm.ensemble) reads
- * integrators and states through it too.  Not for other bindings.
+ * integrators and states through it too, and the integrators of systems on
+ * groups (l_lie_integ.c) run through dm_lua_integ_run.  Not for other
+ * bindings.
  *
  * An Integrator is a userdata "dmech.integrator" holding a dm_linteg; its
  * user value 1 is the System userdata it integrates (kept alive by it),
@@ -83,6 +85,14 @@ void dm_linteg_open_adapt(lua_State *L);
 
 /* Lua functions defined in l_integ_run.c / l_integ_diag.c. */
 int dm_linteg_run(lua_State *L);
+/* integ:run after the state: the options table at o (keys as integ:run's;
+ * h the integrator's step, NAN: none; ls the Lagrangian system whose
+ * coordinates `momentum` names, NULL for a system on a group: momentum =
+ * true | false selects the columns of its momentum map), then dm_run of I
+ * from (t0, q, p) into a new Trajectory (progress line, sink, memory
+ * warning); returns the Lua results: the trajectory[, message]. */
+int dm_lua_integ_run(lua_State *L, dm_integrator *I, const dm_lsystem *ls, int o, double h,
+                     double t0, double *q, double *p);
 int dm_linteg_order_estimate(lua_State *L);   /* l_integ_diag.c */
 
 /* Record the option keys of dm.integrator and integ:run in the docs. */

@@ -65,10 +65,20 @@ static const char *const run_keys[] = {"steps", "t", "every", "progress", "energ
                                        "h", "chunk", "max_energy_error", "strict", "warn", "sink",
                                        "sink_every", NULL};
 
-static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, unsigned char *mom)
+/* momentum = nil | boolean | {coordinate names}: the flags of the
+ * momentum columns.  Without a Lagrangian system (ls NULL: a system on a
+ * group) the columns are those of the system's momentum map, all or none. */
+static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, const dm_system *sys,
+                          unsigned char *mom)
 {
   int type = lua_getfield(L, o, "momentum");
-  if (type == LUA_TNIL) {
+  if (ls == NULL) {
+    if (type != LUA_TNIL && type != LUA_TBOOLEAN)
+      luaL_error(L, "run: option 'momentum' must be a boolean for a system on a group (the "
+                 "spatial momentum columns momentum_1..), got %s", luaL_typename(L, -1));
+    memset(mom, sys->momentum_map != NULL && (type == LUA_TNIL || lua_toboolean(L, -1)),
+           sys->n);
+  } else if (type == LUA_TNIL) {
     memcpy(mom, ls->cyclic, ls->n);
   } else if (type == LUA_TBOOLEAN) {
     if (lua_toboolean(L, -1))
@@ -112,15 +122,16 @@ void dm_linteg_doc_run(lua_State *L)
   dm_doc_options(L, "integrator:run", run_keys);
 }
 
-/* The options table at o into r (momentum flags into mom, n bytes). */
-static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int *show,
-                         unsigned char *mom)
+/* The options table at o into r (momentum flags into mom, n bytes); h:
+ * the integrator's step (NAN: none). */
+static void read_runopts(lua_State *L, int o, const dm_integrator *I, const dm_lsystem *ls,
+                         double h, dm_run_opts *r, int *show, unsigned char *mom)
 {
   lua_Integer steps;
   int has_steps, has_t;
   dm_err e;
   check_keys(L, o);
-  r->h = li->h;
+  r->h = h;
   if (lua_getfield(L, o, "h") != LUA_TNIL) {
     r->h = lua_tonumber(L, -1);
     if (lua_type(L, -1) != LUA_TNUMBER || r->h == 0.0 || !isfinite(r->h))
@@ -165,7 +176,7 @@ static void read_runopts(lua_State *L, int o, dm_linteg *li, dm_run_opts *r, int
     *show = lua_toboolean(L, -1);
   r->energy = lua_getfield(L, o, "energy") == LUA_TNIL || lua_toboolean(L, -1);
   lua_pop(L, 2);
-  read_momentum(L, o, li->ls, mom);
+  read_momentum(L, o, ls, I->sys, mom);
   r->momentum = mom;
   dm_lua_run_check_flags(L, o);
 }
@@ -254,10 +265,10 @@ static double memory_limit(lua_State *L, int opts, int *warn)
 
 /* A warning (through io.stderr, like the run's other warnings) before a
  * run whose trajectory would take more than the limit. */
-static void warn_memory(lua_State *L, int opts, const dm_linteg *li, const dm_run_opts *r)
+static void warn_memory(lua_State *L, int opts, const dm_integrator *I, const dm_run_opts *r)
 {
   int warn, top = lua_gettop(L);
-  double bytes = (double)dm_run_bytes(li->I, r), lim = memory_limit(L, opts, &warn);
+  double bytes = (double)dm_run_bytes(I, r), lim = memory_limit(L, opts, &warn);
   if (!warn || !(lim > 0 && bytes > lim))
     return;
   char msg[512];
@@ -265,7 +276,7 @@ static void warn_memory(lua_State *L, int opts, const dm_linteg *li, const dm_ru
                   "every %ld, %zu coordinates), above dm.config.memory_limit = %.3g MB; record "
                   "less often (every = ...) or stream the samples (sink = \"file.csv\" or a "
                   "function, sink_every = ...)\n", bytes / 1048576.0, r->nsteps, r->every,
-                  li->ls->n, lim / 1048576.0);
+                  I->nq, lim / 1048576.0);
   if (lua_getglobal(L, "io") == LUA_TTABLE && lua_getfield(L, -1, "stderr") != LUA_TNIL &&
       lua_getfield(L, -1, "write") == LUA_TFUNCTION) {
     lua_insert(L, -2);
@@ -280,40 +291,38 @@ static void warn_memory(lua_State *L, int opts, const dm_linteg *li, const dm_ru
 
 /* }====================================================================== */
 
-int dm_linteg_run(lua_State *L)
+int dm_lua_integ_run(lua_State *L, dm_integrator *I, const dm_lsystem *ls, int o, double h,
+                     double t0, double *q, double *p)
 {
-  dm_linteg *li = dm_linteg_check(L, 1);
-  size_t n = li->ls->n;
+  size_t n = I->n;
   unsigned char *mom;
-  dm_lstate s;
   dm_run_opts r;
   dm_run_result res;
   progress pg = {0, 0.0};
   dm_err e;
   int st, show;
-  if (lua_isnoneornil(L, 3)) {
-    lua_settop(L, 2);
-    lua_newtable(L);
-  }
-  luaL_checktype(L, 3, LUA_TTABLE);
-  lua_settop(L, 3);
-  dm_linteg_readstate(L, li, 2, "run", &s);
-  mom = lua_newuserdatauv(L, n, 0);                              /* 4 */
+  o = lua_absindex(L, o);
+  mom = lua_newuserdatauv(L, n, 0);
   memset(mom, 0, n);
   dm_run_opts_init(&r);
-  r.t0 = s.t;
-  read_runopts(L, 3, li, &r, &show, mom);
+  r.t0 = t0;
+  read_runopts(L, o, I, ls, h, &r, &show, mom);
   if (show) {
     r.progress = progress_draw;
     r.progress_ctx = &pg;
   }
   sinkctx sc = { L, 0, 0, NULL };
-  read_sink(L, 3, &r, &sc);                      /* the function stays: 5 */
-  warn_memory(L, 3, li, &r);
-  dm_traj *tr = dm_pushtraj(L, n, li->ls->sys.coords, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V);
+  read_sink(L, o, &r, &sc);                      /* the function stays on the stack */
+  warn_memory(L, o, I, &r);
+  dm_traj **slot = dm_newtraj(L);                /* its home before it exists */
   int tslot = lua_gettop(L);
+  if ((*slot = dm_run_traj_alloc(I, &e)) == NULL) {
+    if (sc.file != NULL)
+      dm_traj_stream_abandon(sc.file);
+    return dm_lua_fail(L, "run", e.status, &e);
+  }
   sc.traj = tslot;
-  st = dm_run(li->I, s.q, s.p, &r, tr, &res, &e);
+  st = dm_run(I, q, p, &r, *slot, &res, &e);
   progress_end(&pg);
   if (sc.file != NULL) {                         /* the file appears, also after an early end */
     dm_err ce;
@@ -330,5 +339,19 @@ int dm_linteg_run(lua_State *L)
   lua_settop(L, tslot);
   if (st == DM_OK)
     return 1;
-  return 1 + dm_lua_run_ended(L, 3, st, e.msg);
+  return 1 + dm_lua_run_ended(L, o, st, e.msg);
+}
+
+int dm_linteg_run(lua_State *L)
+{
+  dm_linteg *li = dm_linteg_check(L, 1);
+  dm_lstate s;
+  if (lua_isnoneornil(L, 3)) {
+    lua_settop(L, 2);
+    lua_newtable(L);
+  }
+  luaL_checktype(L, 3, LUA_TTABLE);
+  lua_settop(L, 3);
+  dm_linteg_readstate(L, li, 2, "run", &s);
+  return dm_lua_integ_run(L, li->I, li->ls, 3, li->h, s.t, s.q, s.p);
 }

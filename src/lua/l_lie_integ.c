@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "lua/l_lie_sys.h"
+#include "lua/l_integ.h"
 
 typedef struct dm_llinteg {
   dm_integrator *I;             /* NULL once closed */
@@ -31,6 +32,16 @@ static dm_llinteg *checkinteg(lua_State *L, int idx)
   if (li->I == NULL)
     luaL_error(L, "attempt to use a closed integrator");
   return li;
+}
+
+dm_integrator *dm_lua_lie_tointeg(lua_State *L, int idx, const dm_lie_system **S, double *h)
+{
+  dm_llinteg *li = luaL_testudata(L, idx, DM_LIEINTEG_MT);
+  if (li == NULL || li->I == NULL)
+    return NULL;
+  *S = li->S;
+  *h = li->h;
+  return li->I;
 }
 
 /* the group userdata of the integrator's system */
@@ -130,60 +141,20 @@ static double get_h(lua_State *L, dm_llinteg *li, int idx, const char *fname)
  * run and step
  * ======================================================================= */
 
-/* I:run(state, {t = | steps =, every =, h =}) -> traj[, message] */
+/* I:run(state, {t = | steps =, every =, h =, ...}) -> traj[, message]:
+ * the core run driver, as integ:run of every other system */
 static int l_run(lua_State *L)
 {
-  static const char *const keys[] = {"t", "steps", "every", "h", "strict", "warn", NULL};
   dm_llinteg *li = checkinteg(L, 1);
   dm_lstate_lie s;
-  dm_lie_run_opts o;
-  dm_err e;
-  dm_traj **slot;
-  int st, has_t, has_steps;
   if (lua_isnoneornil(L, 3)) {
     lua_settop(L, 2);
     lua_newtable(L);
   }
   luaL_checktype(L, 3, LUA_TTABLE);
   lua_settop(L, 3);
-  lua_pushnil(L);
-  while (lua_next(L, 3) != 0) {
-    const char *const *k = keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      return luaL_error(L, "run: unknown option %s (options: t, steps, every, h, strict, warn)",
-                        dm_tolstring(L, -2, NULL));
-    lua_pop(L, 1);
-  }
-  dm_lua_run_check_flags(L, 3);
   dm_lua_lie_readstate(L, li->I, li->S, 2, "run", &s);
-  memset(&o, 0, sizeof o);
-  o.t0 = s.t;
-  lua_getfield(L, 3, "h");
-  o.h = lua_isnil(L, -1) ? get_h(L, li, 0, "run") : step_size(L, "run", luaL_checknumber(L, -1));
-  lua_pop(L, 1);
-  has_t = lua_getfield(L, 3, "t") != LUA_TNIL;
-  has_steps = lua_getfield(L, 3, "steps") != LUA_TNIL;
-  lua_pop(L, 2);
-  if (has_t == has_steps)
-    return luaL_error(L, "run: give exactly one of steps = (a number of steps) or t = (the final "
-                      "time)");
-  o.nsteps = has_steps ? (long)dm_optintegerfield(L, 3, "steps", 0) : -1;
-  if (has_steps && o.nsteps < 0)
-    return luaL_error(L, "run: steps must be >= 0, got %d", (int)o.nsteps);
-  o.t_end = dm_optnumberfield(L, 3, "t", 0.0);
-  o.every = (long)dm_optintegerfield(L, 3, "every", 1);
-  if (o.every < 1)
-    return luaL_error(L, "run: every must be >= 1, got %d", (int)o.every);
-  slot = dm_newtraj(L);
-  st = dm_lie_run(li->I, s.g, s.mu, &o, slot, &e);
-  if (*slot == NULL)
-    return dm_lua_fail(L, "run", st, &e);
-  if (st != DM_OK)
-    return 1 + dm_lua_run_ended(L, 3, st, e.msg);
-  return 1;
+  return dm_lua_integ_run(L, li->I, NULL, 3, li->h, s.t, s.g, s.mu);
 }
 
 /* I:step(state[, h]) -> state */
@@ -391,9 +362,11 @@ static const dm_reg traj_ext[] = {
 /* }====================================================================== */
 
 static const dm_reg integ_methods[] = {
-  {"run", l_run, "integ:run({g =, mu = | xi = [, t =]}, {t = | steps =, every =, h =}) -> traj[, message]",
+  {"run", l_run, "integ:run({g =, mu = | xi = [, t =]}, {t = | steps =, every =, h =, ...}) -> traj[, message]",
    "Integrate into a trajectory with the stored numbers of g, mu1.., xi1.., energy and the "
-   "spatial momentum momentum_1..; an early end returns what was computed and a message."},
+   "spatial momentum momentum_1.. (the run options of every integrator: progress, chunk, "
+   "max_energy_error, sink, strict, warn; momentum = false drops the momentum columns); an "
+   "early end returns what was computed and a message."},
   {"step", l_step, "integ:step(state[, h]) -> state", "One step: {t, g, mu, xi} at t + h."},
   {"energy", l_energy, "integ:energy(state) -> number", "The energy mu . xi - L at the state."},
   {"momentum", l_momentum, "integ:momentum(state) -> vec",

@@ -1,7 +1,9 @@
 /* l_lie_sys.h -- private glue of the bindings of systems on Lie groups
  * (l_lie_system.c) and their integrators (l_lie_integ.c).  Not for other
  * bindings: dm.system and dm.integrator reach them through
- * dm_lua_lie_system and the system's __integrator metamethod.
+ * dm_lua_lie_system and the system's __integrator metamethod; dm.ensemble
+ * (l_ensemble.c) takes the integrator through dm_lua_lie_tointeg and reads
+ * its members' states with dm_lua_lie_readstate.
  *
  * A system is a userdata "dmech.liesystem" owning a dm_lie_system (user
  * value 1: the group userdata of its space); an integrator a userdata
@@ -37,6 +39,10 @@ void dm_lua_lie_readstate(lua_State *L, dm_integrator *I, const dm_lie_system *S
 /* Push {t =, g = element (of the group userdata at gidx), mu = vec, xi = vec}. */
 void dm_lua_lie_pushstate(lua_State *L, int gidx, const dm_lie_system *S, double t,
                           const double *g, const double *mu, const double *xi);
+
+/* The open integrator at idx when it is one of a system on a group (*S
+ * its system, *h its step, NAN when not set), else NULL. */
+dm_integrator *dm_lua_lie_tointeg(lua_State *L, int idx, const dm_lie_system **S, double *h);
 
 /* dm.integrator(sys, opts) for a system on a group (the __integrator
  * metamethod of the system). */

@@ -122,18 +122,19 @@ static size_t sample_index(lua_Integer k, size_t len)
  * every column also appears under its own name (t, q, p, v win a clash). */
 static void push_sample(lua_State *L, const dm_traj *tr, size_t k)
 {
-  size_t j, i, n = dm_traj_ncoords(tr), nc = dm_traj_ncols(tr);
+  size_t j, i, nc = dm_traj_ncols(tr);
   const char *kinds[3] = {"q", "p", "v"};
   lua_createtable(L, 0, (int)nc + 4);
   for (j = 0; j < nc; j++) {
     lua_pushnumber(L, dm_traj_col(tr, j)[k]);
     lua_setfield(L, -2, dm_traj_colname(tr, j));
   }
-  for (i = 0; i < 3 && n > 0; i++) {
+  for (i = 0; i < 3; i++) {
+    size_t n = i == 0 ? dm_traj_ncoords(tr) : dm_traj_nmomenta(tr);
     size_t j0 = i == 0 ? dm_traj_qcol(tr, 0) : i == 1 ? dm_traj_pcol(tr, 0)
                                                         : dm_traj_vcol(tr, 0);
     gsl_vector *x;
-    if (j0 == DM_TRAJ_NONE)
+    if (n == 0 || j0 == DM_TRAJ_NONE)
       continue;
     x = dm_pushvec(L, n);
     for (j = 0; j < n; j++)
@@ -174,6 +175,8 @@ static int push_array_proxy(lua_State *L, const dm_traj *tr, char kind, const ch
 {
   size_t n = dm_traj_ncoords(tr), ln = strlen(name), first = n, count = 0;
   char want[DM_TRAJ_NAME_MAX + 32];
+  if (kind != 'q' && dm_traj_named_momenta(tr))
+    return 0;                     /* p and v are not per coordinate */
   for (size_t i = 0; i < n; i++) {
     const char *c = dm_traj_coord(tr, i);
     if (strncmp(c, name, ln) == 0 && c[ln] == '[') {
@@ -235,20 +238,32 @@ static int arr_tostring(lua_State *L)
   return 1;
 }
 
+/* The name the i-th column of a kind is indexed by: the coordinate, or
+ * for named momenta the column's own name. */
+static const char *col_key(const dm_traj *tr, char kind, int named, size_t i)
+{
+  if (!named)
+    return dm_traj_coord(tr, i);
+  return dm_traj_colname(tr, kind == 'p' ? dm_traj_pcol(tr, i) : dm_traj_vcol(tr, i));
+}
+
 static int cols_index(lua_State *L)
 {
   char kind = *(char *)luaL_checkudata(L, 1, COLS_MT);
   dm_traj *tr;
   size_t i, n, j;
+  int named;
   lua_getiuservalue(L, 1, 1);
   tr = open_traj(L, -1);
-  n = dm_traj_ncoords(tr);
+  /* named momenta: p and v by their own column names */
+  named = kind != 'q' && dm_traj_named_momenta(tr);
+  n = kind == 'q' ? dm_traj_ncoords(tr) : dm_traj_nmomenta(tr);
   if (lua_type(L, 2) == LUA_TNUMBER) {
     lua_Integer k = luaL_checkinteger(L, 2);
     i = k >= 1 && (lua_Unsigned)k <= n ? (size_t)k - 1 : n;
   } else {
     const char *name = dm_checkcstring(L, 2);
-    for (i = 0; i < n && strcmp(dm_traj_coord(tr, i), name) != 0; i++)
+    for (i = 0; i < n && strcmp(col_key(tr, kind, named, i), name) != 0; i++)
       ;
     if (i == n && push_array_proxy(L, tr, kind, name))
       return 1;
@@ -258,12 +273,13 @@ static int cols_index(lua_State *L)
     const char *key = dm_tolstring(L, 2, NULL);
     luaL_Buffer b;
     luaL_buffinit(L, &b);
-    lua_pushfstring(L, "no coordinate %s%s%s (coordinates: ", q, key, q);
+    lua_pushfstring(L, "no %s %s%s%s (%s: ", named ? "column" : "coordinate", q, key, q,
+                    !named ? "coordinates" : kind == 'p' ? "momenta" : "velocities");
     luaL_addvalue(&b);
     for (j = 0; j < n; j++) {
       if (j > 0)
         luaL_addstring(&b, ", ");
-      luaL_addstring(&b, dm_traj_coord(tr, j));
+      luaL_addstring(&b, col_key(tr, kind, named, j));
     }
     luaL_addchar(&b, ')');
     luaL_pushresult(&b);
@@ -277,9 +293,11 @@ static int cols_index(lua_State *L)
 
 static int cols_len(lua_State *L)
 {
-  luaL_checkudata(L, 1, COLS_MT);
+  char kind = *(char *)luaL_checkudata(L, 1, COLS_MT);
+  dm_traj *tr;
   lua_getiuservalue(L, 1, 1);
-  lua_pushinteger(L, (lua_Integer)dm_traj_ncoords(open_traj(L, -1)));
+  tr = open_traj(L, -1);
+  lua_pushinteger(L, (lua_Integer)(kind == 'q' ? dm_traj_ncoords(tr) : dm_traj_nmomenta(tr)));
   return 1;
 }
 

@@ -725,6 +725,84 @@ static void test_enomem(dm_traj *inherited)
          "resumes (child status %d)", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
 }
 
+/* A configuration stored in more numbers than it has momenta (a rotation:
+ * 9 entries, 3 momenta): named p and v columns through append, get,
+ * derive, slice, the CSV round trip and the loader's checks. */
+static int np_sum(void *ctx, const dm_traj_sample *s, double *out)
+{
+  (void)ctx;
+  out[0] = (double)s->np + s->p[2] + 10.0 * s->v[0] + 100.0 * s->q[8];
+  return 0;
+}
+
+static void test_named_momenta(void)
+{
+  static const char *const g[] = {"R11", "R12", "R13", "R21", "R22", "R23", "R31", "R32", "R33"};
+  static const char *const mu[] = {"mu1", "mu2", "mu3"}, *const xi[] = {"xi1", "xi2", "xi3"};
+  static const char *const dname[] = {"d"};
+  double q[9], p[3], v[3], t, q2[9], p2[3], v2[3];
+  dm_traj *tr, *s, *l;
+  dm_err e;
+  size_t k, i;
+  int ok = 1;
+  tr = dm_traj_alloc_state(9, g, 3, NULL, NULL, DM_TRAJ_WITH_P, &e);
+  tap_ok(tr == NULL && e.status == DM_EINVAL && has(e.msg, "3 momenta for 9 coordinates need "
+         "the names of their p and v columns"), "alloc_state without names: %s", e.msg);
+  tr = dm_traj_alloc_state(9, g, 3, mu, NULL, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, &e);
+  tap_ok(tr == NULL && e.status == DM_EINVAL, "alloc_state: v asked for, no v names: %s", e.msg);
+  tr = dm_traj_alloc_state(9, g, 3, mu, xi, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, &e);
+  tap_ok(tr != NULL && dm_traj_ncoords(tr) == 9 && dm_traj_nmomenta(tr) == 3
+         && dm_traj_named_momenta(tr) && dm_traj_ncols(tr) == 16, "9 coordinates, 3 momenta");
+  if (tr == NULL)
+    return;
+  tap_ok(dm_traj_pcol(tr, 2) == 12 && dm_traj_vcol(tr, 0) == 13 && dm_traj_vcol(tr, 3) == DM_TRAJ_NONE
+         && strcmp(dm_traj_colname(tr, dm_traj_pcol(tr, 1)), "mu2") == 0
+         && dm_traj_colkind(tr, 15) == DM_TRAJ_V, "p and v columns by their own names and kinds");
+  dm_traj_add_column(tr, "energy", DM_TRAJ_DIAG, NULL, 0, NULL);
+  for (k = 0; k < 5; k++) {
+    double x = 2.385 * (double)k + 0.125;
+    for (i = 0; i < 9; i++)
+      q[i] = sin(x + (double)i);
+    for (i = 0; i < 3; i++) {
+      p[i] = cos(x * (double)(i + 1));
+      v[i] = -p[i] / (double)(i + 2);
+    }
+    dm_traj_append(tr, 0.1 * (double)k, q, p, v, &x, NULL);
+  }
+  dm_traj_get(tr, 3, &t, q2, p2, v2, NULL);
+  tap_ok(t == 0.30000000000000004 && q2[8] == sin(2.385 * 3 + 0.125 + 8.0)
+         && p2[2] == cos((2.385 * 3 + 0.125) * 3.0) && v2[1] == -cos((2.385 * 3 + 0.125) * 2.0) / 3.0
+         && dm_traj_col(tr, 16)[3] == 2.385 * 3 + 0.125, "get: q (9), p and v (3), extra");
+  tap_ok(dm_traj_derive(tr, 1, dname, DM_TRAJ_DERIVED, np_sum, NULL, 0, &e) == DM_OK
+         && dm_traj_col(tr, 17)[3] == 3.0 + p2[2] + 10.0 * v2[0] + 100.0 * q2[8],
+         "derive sees np = 3 and the named p, v");
+  s = dm_traj_slice(tr, 1, 5, 2, &e);
+  tap_ok(s != NULL && dm_traj_len(s) == 2 && dm_traj_nmomenta(s) == 3 && dm_traj_named_momenta(s)
+         && strcmp(dm_traj_colname(s, 14), "xi2") == 0 && dm_traj_col(s, 12)[1] == dm_traj_col(tr, 12)[3],
+         "slice keeps the named momenta");
+  dm_traj_free(s);
+  dm_traj_meta_set(tr, "space", "SO3", NULL);
+  tap_ok(dm_traj_save(tr, path_in("named.csv"), &e) == DM_OK, "save: %s", e.msg);
+  l = dm_traj_load(path_in("named.csv"), &e);
+  tap_ok(l != NULL && dm_traj_named_momenta(l) && dm_traj_nmomenta(l) == 3 && roundtrip_same(tr, l),
+         "CSV round trip, bit for bit: %s", l ? "" : e.msg);
+  dm_traj_free(l);
+  dm_traj_free(tr);
+  /* the first p column not "p_...": named; p and v runs must match */
+  write_file("onlyv.csv", "# dmech trajectory 2\n# kinds t,q,q,v\nt,a,b,w\n1,2,3,4\n");
+  l = dm_traj_load(path_in("onlyv.csv"), &e);
+  ok = l != NULL && dm_traj_ncoords(l) == 2 && dm_traj_nmomenta(l) == 1
+       && dm_traj_vcol(l, 0) == 3 && dm_traj_pcol(l, 0) == DM_TRAJ_NONE;
+  tap_ok(ok, "v columns alone, named: one velocity for two coordinates");
+  dm_traj_free(l);
+  expect_load_error("vcount.csv", "# dmech trajectory 2\n# kinds t,q,q,p,v,v\nt,a,b,mu1,xi1,xi2\n",
+                    DM_EINVAL, "vcount.csv:3: 2 velocity columns of kind v for 1 momentum "
+                    "columns of kind p");
+  expect_load_error("vname.csv", "# dmech trajectory 2\n# kinds t,q,p,v\nt,a,p_a,w\n",
+                    DM_EINVAL, "vname.csv:3: expected velocity column 'v_a' of kind v after the "
+                    "q and p columns");
+}
+
 static void cleanup(void)
 {
   static const char *const files[] = {
@@ -732,7 +810,8 @@ static void cleanup(void)
     "emptyf.csv", "blank.csv", "first.csv", "empty.csv", "onlycomments.csv", "nokinds.csv",
     "version.csv", "count.csv", "kind.csv", "pname.csv", "order.csv", "twokinds.csv",
     "meta.csv", "esc.csv", "dupmeta.csv", "dupcol.csv", "headblank.csv", "plain.csv",
-    "keep.csv", "nummeta.csv", "v1.csv", "badnum.csv", NULL
+    "keep.csv", "nummeta.csv", "v1.csv", "badnum.csv", "named.csv", "onlyv.csv", "vcount.csv",
+    "vname.csv", NULL
   };
   int i;
   char cmd[700];
@@ -771,6 +850,7 @@ int main(void)
   test_locale();
   test_numeric_meta();
   test_malformed();
+  test_named_momenta();
   test_write_failures(big);
   test_enomem(big);
   dm_traj_free(big);

@@ -233,6 +233,34 @@ static void errors(void)
   }
 }
 
+/* Named momenta (9 stored numbers, 3 momenta): through HDF5 and back. */
+static void named_momenta(void)
+{
+  static const char *const g[] = {"R11", "R12", "R13", "R21", "R22", "R23", "R31", "R32", "R33"};
+  static const char *const mu[] = {"mu1", "mu2", "mu3"}, *const xi[] = {"xi1", "xi2", "xi3"};
+  dm_traj *a = dm_traj_alloc_state(9, g, 3, mu, xi, DM_TRAJ_WITH_P | DM_TRAJ_WITH_V, NULL), *b;
+  dm_err e;
+  size_t k, i;
+  dm_traj_add_column(a, "energy", DM_TRAJ_DIAG, NULL, 0, NULL);
+  for (k = 0; k < 7; k++) {
+    double q[9], p[3], v[3], E = 2.385 * (double)k;
+    for (i = 0; i < 9; i++)
+      q[i] = cos(0.3 * (double)(k + i));
+    for (i = 0; i < 3; i++) {
+      p[i] = sin(1.7 * (double)(k + i));
+      v[i] = p[i] / 1.3;
+    }
+    dm_traj_append(a, 0.05 * (double)k, q, p, v, &E, NULL);
+  }
+  dm_traj_meta_set(a, "space", "SO3", NULL);
+  b = dm_traj_save_h5(a, at("named.h5"), &e) == DM_OK ? dm_traj_load_h5(at("named.h5"), &e) : NULL;
+  tap_ok(b != NULL && same(a, b) && dm_traj_nmomenta(b) == 3 && dm_traj_named_momenta(b),
+         "named momenta (mu1.., xi1..) through HDF5, bit for bit%s%s", b ? "" : ": ",
+         b ? "" : e.msg);
+  dm_traj_free(a);
+  dm_traj_free(b);
+}
+
 int main(void)
 {
   const char *tmp = getenv("TMPDIR");
@@ -241,6 +269,7 @@ int main(void)
     return 1;
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   round_trips();
+  named_momenta();
   foreign();
   errors();
   {

@@ -191,8 +191,8 @@ T.group("errors", function()
     "dm%.integrator: h must be a finite number > 0, got 0", "h = 0")
   T.error_like(function() dm.integrator(top, {method = "lgvi", h = -0.1}) end,
     "dm%.integrator: h must be a finite number > 0, got %-0%.1", "h < 0")
-  T.error_like(function() I:run(s0, {t = 1, h = -1}) end, "run: h must be a finite number > 0",
-    "run with h < 0")
+  T.error_like(function() I:run(s0, {t = 1, h = -1}) end,
+    "run: the final time t = 1 cannot be reached from t0 = 0 with h = %-1", "run with h < 0 to t > 0")
   T.error_like(function() I:step(s0, 0) end, "step: h must be a finite number > 0", "step h = 0")
   T.error_like(function() dm.integrator(top, {method = "gauss"}) end,
     "dm%.integrator: method 'gauss' does not apply to system 'heavy top' %(a lie system%); it integrates .- systems %(methods here: lgvi, lie:gauss, lie:gauss:cayley, gsl:<stepper>%)",
