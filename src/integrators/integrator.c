@@ -320,7 +320,7 @@ int dm_integrator_step_until(dm_integrator *I, double h, double t_end, const dou
       *reached = 1;
     }
     if (hh == 0.0) {
-      memmove(q1, q0, I->n * sizeof *q1);
+      memmove(q1, q0, I->nq * sizeof *q1);
       memmove(p1, p0, I->n * sizeof *p1);
       return DM_OK;
     }
@@ -338,7 +338,7 @@ int dm_integrator_step_until(dm_integrator *I, double h, double t_end, const dou
     return st;
   if ((st = I->type->step_until(I, h, t_end, q0, p0, q1, p1, reached, e)) != DM_OK)
     return st;
-  if (!finite_vec(q1, I->n) || !finite_vec(p1, I->n))
+  if (!finite_vec(q1, I->nq) || !finite_vec(p1, I->n))
     return dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
   return DM_OK;
 }

@@ -150,7 +150,7 @@ static void read_runopts(lua_State *L, int o, const dm_integrator *I, const dm_l
     if (steps < 0)
       luaL_error(L, "run: steps must be >= 0, got %d", (int)steps);
     r->nsteps = (long)steps;
-  } else if (dm_integrator_varstep(li->I)) {
+  } else if (dm_integrator_varstep(I)) {
     /* the integrator keeps the physical time: the run steps until t */
     r->t_end = dm_optnumberfield(L, o, "t", 0);
     if (dm_run_steps_to(r->t0, r->t_end, r->h, &r->nsteps, &e) != DM_OK)
