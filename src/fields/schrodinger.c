@@ -8,6 +8,7 @@
 #include "core/interrupt.h"
 #include "core/numfmt.h"
 
+#include <complex.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>

@@ -32,6 +32,12 @@ const dm_option_desc dm_integ_options[] = {
   {"adaptive", DM_OPT_BOOL, OPT(adaptive), 0, 1, "gsl:*: adaptive steps inside each h"},
   {"epsabs", DM_OPT_DOUBLE, OPT(epsabs), 0, 1, "gsl:*: absolute tolerance (default 1e-10)"},
   {"epsrel", DM_OPT_DOUBLE, OPT(epsrel), 0, 1, "gsl:*: relative tolerance (default 1e-10)"},
+  {"omega", DM_OPT_DOUBLE, OPT(omega), 0, HUGE_VAL,
+   "multiscale: the fast frequency (default 0: estimated from the start)"},
+  {"fast", DM_OPT_STRING, OPT(fast), 0, 0,
+   "multiscale: the fast coordinates, comma-separated (default: the estimate's)"},
+  {"nodes", DM_OPT_INT, OPT(nodes), 3, 12, "multiscale: Lobatto nodes in time (default 4)"},
+  {"phases", DM_OPT_INT, OPT(phases), 4, 64, "multiscale: phases of the oscillation sampled (default 8)"},
   {"linear", DM_OPT_STRING, OPT(linear), 0, 0,
    "Newton matrices: dense LU, sparse LU (KLU) or auto (default: sparse for large sparse systems)"},
   {NULL, 0, 0, 0, 0, 0, NULL}
@@ -51,6 +57,8 @@ void dm_integ_opts_init(dm_integ_opts *o)
   o->epsrel = 1e-10;
   strcpy(o->linear, "auto");
   o->power = 1.0;
+  o->nodes = 4;
+  o->phases = 8;
 }
 
 const dm_option_desc *dm_integ_option_find(const char *name)
@@ -294,10 +302,9 @@ int dm_integrator_begin(dm_integrator *I, double h, double t0, const double *q0,
   if (!isfinite(h) || h == 0.0 || !isfinite(t0))
     return dm_err_set(e, DM_EINVAL, "begin: need a finite step h != 0 and a finite start time");
   I->begun = 0;
-  if (dm_integrator_varstep(I) && I->type->begin != NULL) {
-    if ((st = I->type->begin(I, h, t0, q0, p0, e)) != DM_OK)
-      return st;
-  } else {
+  if (I->type->begin != NULL && (st = I->type->begin(I, h, t0, q0, p0, e)) != DM_OK)
+    return st;
+  if (!dm_integrator_varstep(I) || I->type->begin == NULL) {
     I->t = t0;
     I->dt = h;
   }

@@ -85,6 +85,10 @@ typedef struct dm_integ_opts {
                                   * potential's, (U(q0)/U(q))^power, U = -V */
   double power;        /* adapt: exponent of the potential's monitor (1:
                         * Sundman's dt = r ds for a 1/r potential) */
+  double omega;        /* multiscale: the fast frequency (0: estimated) */
+  char fast[DM_INTEG_STRMAX];    /* multiscale: fast coordinates, comma-separated */
+  int nodes;           /* multiscale: Lobatto nodes of the Filon rule (4) */
+  int phases;          /* multiscale: phases sampled per step (8) */
 } dm_integ_opts;
 
 enum dm_opt_kind { DM_OPT_INT, DM_OPT_DOUBLE, DM_OPT_BOOL, DM_OPT_STRING };
@@ -162,14 +166,17 @@ typedef struct dm_integrator_type {
   /* Further method names the family answers to besides `name` (the
    * instance sees the one requested in I->name), NULL-ended; may be NULL. */
   const char *const *names;
-  /* Families with variable physical steps (DM_INTEG_VARSTEP; NULL for the
-   * others).  begin: start a run at physical time t0 from (q0, p0) with
+  /* begin (optional for every family): start a run from (q0, p0) -- a
+   * family may fix what depends on the start (a fast frequency).  For
+   * families with variable physical steps (DM_INTEG_VARSTEP) it is
+   * required and more: begin: start a run at physical time t0 from (q0, p0) with
    * the nominal step h -- latch what the run keeps fixed (an energy
    * level), set I->t = t0 and I->dt to the length of the first step (or
    * its first-order estimate).  Every step then advances I->t by the step's
    * physical length and sets I->dt to it.  step_until: one step of nominal
    * size h that, when it would pass the physical time t_end, is replaced by
-   * a shorter one ending there exactly (I->t = t_end, *reached = 1). */
+   * a shorter one ending there exactly (I->t = t_end, *reached = 1);
+   * NULL for the others. */
   int (*begin)(dm_integrator *I, double h, double t0, const double *q0, const double *p0,
                dm_err *e);
   int (*step_until)(dm_integrator *I, double h, double t_end, const double *q0,
@@ -265,10 +272,9 @@ void dm_integrator_reset(dm_integrator *I);
 int dm_integrator_step(dm_integrator *I, double h, const double *q0, const double *p0,
                        double *q1, double *p1, dm_err *e);
 
-/* Families with variable physical steps (DM_INTEG_VARSTEP).  begin: the
- * type's begin for those (a family that steps before begin was called
- * begins at t0 = 0 from the first step's start), else I->t = t0 and
- * I->dt = h.  step_until: the type's step_until for those; for the others
+/* Start a run: the type's begin when it has one (a VARSTEP family that
+ * steps before begin was called begins at t0 = 0 from the first step's
+ * start); I->t = t0 and I->dt = h for fixed-step families.  step_until: the type's step_until for those; for the others
  * a step of h, or of t_end - I->t when that is shorter (same sign as h). */
 int dm_integrator_begin(dm_integrator *I, double h, double t0, const double *q0,
                         const double *p0, dm_err *e);

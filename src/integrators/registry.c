@@ -15,7 +15,7 @@
 
 extern const dm_integrator_type dm_integ_midpoint, dm_integ_gauss, dm_integ_trapezoid,
   dm_integ_lobatto, dm_integ_prk, dm_integ_composition, dm_integ_rk4, dm_integ_gsl,
-  dm_integ_adapt, dm_integ_sem;
+  dm_integ_adapt, dm_integ_sem, dm_integ_multiscale;
 
 static const dm_integrator_type *const builtin[] = {
   &dm_integ_midpoint,
@@ -27,7 +27,8 @@ static const dm_integrator_type *const builtin[] = {
   &dm_integ_rk4,
   &dm_integ_gsl,
   &dm_integ_adapt,
-  &dm_integ_sem
+  &dm_integ_sem,
+  &dm_integ_multiscale
 };
 #define NBUILTIN (sizeof builtin / sizeof builtin[0])
 

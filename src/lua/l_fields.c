@@ -10,12 +10,15 @@
  * analysed by FFT.  Runs and eigenpairs are C; this file reads options
  * and converts. */
 #include <config.h>
-#include <complex.h>
 #include <math.h>
 #include <string.h>
 
 #include "fields/fields.h"
+#include "integrators/multiscale.h"
 #include "lua/dmlua.h"
+#include "lua/l_system.h"
+/* after the headers that name parameters I */
+#include <complex.h>
 
 #define SCHROD_MT "dmech.schrodinger"
 #define WAVE_MT "dmech.wave"
@@ -63,12 +66,15 @@ static dm_schrod *wave_owner(lua_State *L, int widx)
   return checkschrod(L, -1)->S;
 }
 
-/* Raise "<what>: <message>" without the C message's own "schrodinger: ". */
+/* Raise "<what>: <message>" without the C message's own "schrodinger: "
+ * or "msfem: ". */
 static int fail(lua_State *L, const char *what, int st, const dm_err *e)
 {
   const char *m = e->msg;
   if (strncmp(m, "schrodinger: ", 13) == 0)
     m += 13;
+  else if (strncmp(m, "msfem: ", 7) == 0)
+    m += 7;
   if (st == DM_ENOMEM)
     return luaL_error(L, "%s: out of memory", what);
   return luaL_error(L, "%s: %s", what, m[0] ? m : dm_strstatus(st));
@@ -460,7 +466,17 @@ static const luaL_Reg schrod_meta[] = {
 };
 static const luaL_Reg wave_meta[] = {{"__tostring", w_tostring}, {NULL, NULL}};
 
+static int l_msfem(lua_State *L);
+static int l_fast_frequency(lua_State *L);
+
 static const dm_reg field_funcs[] = {
+  {"msfem", l_msfem,
+   "dm.msfem{a = function(y) ... end, f = function(x) ... end, eps =, N =[, Phi =, method = \"multiscale\", tol =]} -> x, U",
+   "Solve (a(x/eps) u')' = f on (0, 1), u(0) = u(1) = 0, with N multiscale finite elements "
+   "(exact at the nodes; Phi(x) = int_0^x ds/a(s/eps) when known) or linear ones."},
+  {"fast_frequency", l_fast_frequency, "dm.fast_frequency(sys, {q =, p =}) -> omega, coord",
+   "The fast frequency at a state (the linearisation, refined by the FFT of a short resolved "
+   "run) and the coordinate that carries it, for method = \"multiscale\"."},
   {"schrodinger", l_schrodinger,
    "dm.schrodinger{K = 16, hbar = 1, m = 1, V = function(x) ... end | number, samples =} -> S",
    "The pseudospectral variational integrator of i hbar psi_t = -(hbar^2/2m) psi_xx + V psi on "
@@ -468,6 +484,135 @@ static const dm_reg field_funcs[] = {
    "2 >= 4096 and > 4K) and Fourier-transformed by FFTW."},
   {NULL, NULL, NULL, NULL}
 };
+
+
+/* {==== multiscale: dm.msfem, dm.fast_frequency ========================== */
+
+/* A Lua function of one number called from C under lua_pcall; the first
+ * failure's message is kept in stack slot `err`. */
+typedef struct lfn1 {
+  lua_State *L;
+  int fn, err;
+  const char *what;
+} lfn1;
+
+static int call_fn1(void *data, double x, double *y)
+{
+  lfn1 *c = data;
+  lua_State *L = c->L;
+  int isnum;
+  if (c->fn == 0)
+    return -1;
+  lua_pushvalue(L, c->fn);
+  lua_pushnumber(L, x);
+  if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
+    if (lua_isnil(L, c->err))
+      lua_replace(L, c->err);
+    else
+      lua_pop(L, 1);
+    return -1;
+  }
+  *y = lua_tonumberx(L, -1, &isnum);
+  if (!isnum) {
+    if (lua_isnil(L, c->err)) {
+      lua_pushfstring(L, "%s must return a number, got %s at %f", c->what, luaL_typename(L, -1), x);
+      lua_replace(L, c->err);
+    }
+    lua_pop(L, 1);
+    return -1;
+  }
+  lua_pop(L, 1);
+  return 0;
+}
+
+static const char *const msfem_keys[] = {"a", "f", "eps", "N", "Phi", "method", "tol", NULL};
+
+/* dm.msfem{a = function(y), f = function(x), eps =, N =[, Phi =, method =, tol =]} -> x, U */
+static int l_msfem(lua_State *L)
+{
+  static const char *const methods[] = {"multiscale", "linear", NULL};
+  dm_msfem_problem P;
+  lfn1 ca, cf, cp;
+  dm_err e;
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_settop(L, 1);
+  lua_pushnil(L);
+  while (lua_next(L, 1) != 0) {
+    const char *const *k = msfem_keys;
+    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
+    while (key && *k && strcmp(*k, key) != 0)
+      k++;
+    if (key == NULL || *k == NULL)
+      unknown_key(L, "dm.msfem", "field", "a, f, eps, N, Phi, method, tol");
+    lua_pop(L, 1);
+  }
+  lua_Integer N = dm_optintegerfield(L, 1, "N", 0);
+  double eps = dm_optnumberfield(L, 1, "eps", NAN), tol = dm_optnumberfield(L, 1, "tol", 0);
+  int mi = 0;
+  if (lua_getfield(L, 1, "method") != LUA_TNIL) {
+    const char *m = lua_tostring(L, -1);
+    for (; m && methods[mi] && strcmp(methods[mi], m) != 0; mi++)
+      ;
+    if (m == NULL || methods[mi] == NULL)
+      luaL_error(L, "dm.msfem: method must be multiscale or linear, got %s", luaL_tolstring(L, -1, NULL));
+  }
+  lua_pop(L, 1);
+  if (N < 3 || N > 1000000)
+    luaL_error(L, "dm.msfem: N must be an integer in 3..1e6 (the elements), got %d", (int)N);
+  lua_getfield(L, 1, "a");                                      /* 2 */
+  lua_getfield(L, 1, "f");                                      /* 3 */
+  lua_getfield(L, 1, "Phi");                                    /* 4 */
+  if (!lua_isfunction(L, 2) || !lua_isfunction(L, 3))
+    luaL_error(L, "dm.msfem: a (a function of y = x/eps) and f (a function of x) are required");
+  if (!lua_isnil(L, 4) && !lua_isfunction(L, 4))
+    luaL_error(L, "dm.msfem: Phi must be a function of x, got %s", luaL_typename(L, 4));
+  lua_pushnil(L);                                               /* 5: the first error */
+  ca = (lfn1){L, 2, 5, "a"};
+  cf = (lfn1){L, 3, 5, "f"};
+  cp = (lfn1){L, lua_isnil(L, 4) ? 0 : 4, 5, "Phi"};
+  gsl_vector *x = dm_pushvec(L, (size_t)N + 1), *U = dm_pushvec(L, (size_t)N + 1);  /* 6, 7 */
+  memset(&P, 0, sizeof P);
+  P.a = call_fn1;
+  P.f = call_fn1;
+  P.Phi = cp.fn ? call_fn1 : NULL;
+  P.adata = &ca;
+  P.fdata = &cf;
+  P.phidata = &cp;
+  P.eps = eps;
+  P.tol = tol;
+  int st = dm_msfem1d(&P, (size_t)N, mi == 0 ? DM_MSFEM_MULTISCALE : DM_MSFEM_LINEAR, x->data,
+                      U->data, &e);
+  if (!lua_isnil(L, 5))
+    return luaL_error(L, "dm.msfem: %s", lua_tostring(L, 5));
+  if (st != DM_OK)
+    return fail(L, "dm.msfem", st, &e);
+  return 2;
+}
+
+/* dm.fast_frequency(sys, {q =, p =}) -> omega, coordinate */
+static int l_fast_frequency(lua_State *L)
+{
+  dm_lsystem *ls = dm_lua_checksystem(L, 1);
+  double w, *q, *p;
+  size_t co;
+  dm_err e;
+  luaL_checktype(L, 2, LUA_TTABLE);
+  lua_settop(L, 2);
+  q = lua_newuserdatauv(L, 2 * ls->n * sizeof *q, 0);           /* 3 */
+  p = q + ls->n;
+  if (lua_getfield(L, 2, "q") == LUA_TNIL || lua_getfield(L, 2, "p") == LUA_TNIL)
+    return luaL_error(L, "fast_frequency: the state needs q and p (momenta)");
+  dm_lua_system_readvec(L, ls, 4, "fast_frequency: state.q", q);
+  dm_lua_system_readvec(L, ls, 5, "fast_frequency: state.p", p);
+  int st = dm_multiscale_frequency(&ls->sys, q, p, &w, &co, &e);
+  if (st != DM_OK)
+    return dm_lua_fail(L, "fast_frequency", st, &e);
+  lua_pushnumber(L, w);
+  lua_pushstring(L, ls->sys.coords ? ls->sys.coords[co] : "?");
+  return 2;
+}
+
+/* }====================================================================== */
 
 void dm_open_fields(lua_State *L)
 {
@@ -486,4 +631,5 @@ void dm_open_fields(lua_State *L)
   dm_register(L, "dm.", field_funcs);
   dm_doc_options(L, "dm.schrodinger", schrod_keys);
   dm_doc_options(L, "schrodinger:run", run_keys);
+  dm_doc_options(L, "dm.msfem", msfem_keys);
 }

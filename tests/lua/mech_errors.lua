@@ -16,7 +16,7 @@ local function integ(o) return function() return dm.integrator(kep, o) end end
 
 -- methods and options
 err("bad argument #1 to '.-' %(system expected, got table%)", "not a system", function() dm.integrator({}, {}) end)
-err("dm.integrator: unknown integration method 'gaus' %(known: midpoint, gauss, trapezoid, lobatto, prk, composition, rk4, gsl:<stepper>, adapt:<method>, sem%)$",
+err("dm.integrator: unknown integration method 'gaus' %(known: midpoint, gauss, trapezoid, lobatto, prk, composition, rk4, gsl:<stepper>, adapt:<method>, sem, multiscale%)$",
     "unknown method lists the known ones", integ{method = "gaus"})
 -- an error from dm.integrator is located at the caller's line (no Lua wrapper
 -- between the user and the C function)
