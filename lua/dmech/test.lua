@@ -458,8 +458,11 @@ function T.symplectic(integ, st, tol, name)
   if type(tol) ~= "number" or not (tol >= 0) then argerror(3, "symplectic", "tolerance expected (a number >= 0)") end
   checkname(name, 4, "symplectic")
   local d = integ:symplecticity_defect(st)
+  -- on a Lie group the form is the canonical one of T*G at mu (doc/lie.md)
+  local on_group = pcall(function() return integ.system:space() end)
+  local form = on_group and "max|DPhi^T Omega(mu1) DPhi - Omega(mu0)|" or "max|DPhi^T J DPhi - J|"
   return report(d <= tol, name or "symplectic", function()
-    return ("symplecticity defect max|DPhi^T J DPhi - J| = %s, allowed %s"):format(short(d), short(tol))
+    return ("symplecticity defect %s = %s, allowed %s"):format(form, short(d), short(tol))
   end), d
 end
 
@@ -613,7 +616,7 @@ if ok and type(core) == "table" and core.doc then
   doc("order", "T.order(f, {h1, h2, ...}, p, tol[, name]) -> pass, slope, errors",
     "Fit the slope of log(error) against log(h) for the errors f(h) (numbers, or vectors by their max norm) and pass when |slope - p| <= tol; prints the table of h, error and observed order.")
   doc("symplectic", "T.symplectic(integ, state, tol[, name]) -> pass, defect",
-    "Pass when integ:symplecticity_defect(state), the largest entry of |DPhi^T J DPhi - J| for one step, is at most tol.")
+    "Pass when integ:symplecticity_defect(state), the largest entry of |DPhi^T J DPhi - J| for one step (for a system on a Lie group |DPhi^T Omega(mu1) DPhi - Omega(mu0)|, Omega the canonical form of T*G), is at most tol.")
   doc("group", "T.group(name, f) -> pass",
     "Run f with \"name: \" before its test names; an error inside f is one failed test and the file goes on.")
   doc("todo", "T.todo(reason, f)",

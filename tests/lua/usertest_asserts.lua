@@ -288,6 +288,21 @@ local rk4 = dm.integrator(kep, {method = "rk4", h = 0.05})
 out, c = T._capture(function() T.symplectic(rk4, k0, 1e-8, "rk4") end)
 T.like(out, "^not ok 1 %- rk4\n.*defect max|DPhi^T J DPhi %- J| = %d%.%d%de%-0[5-7], allowed 1e%-08\n$",
   "symplectic fails for rk4 with its defect")
+do -- on a Lie group the defect is that of the canonical form of T*SO(3)
+  local SO3 = dm.lie.SO3()
+  local top = dm.system{space = SO3, params = {J1 = 1.3, J2 = 2.1, J3 = 3.4, mgl = 2.943},
+    L = function(R, Om, p)
+      return 0.5 * (p.J1 * Om[1]^2 + p.J2 * Om[2]^2 + p.J3 * Om[3]^2) - p.mgl * R[3][3]
+    end}
+  local t0 = {g = SO3.exp{0.5, -0.2, 0.3}, mu = {0.3, 2.385, -0.4}}
+  T.ok(T.symplectic(dm.integrator(top, {method = "lgvi", h = 0.2}), t0, 1e-8, "lgvi on SO3"),
+       "symplectic passes for lgvi on SO(3)")
+  out = T._capture(function()
+    T.symplectic(dm.integrator(top, {method = "gsl:rk4", h = 0.2}), t0, 1e-8, "rk4 on SO3")
+  end)
+  T.like(out, "^not ok 1 %- rk4 on SO3\n.*defect max|DPhi^T Omega%(mu1%) DPhi %- Omega%(mu0%)| = "
+         .. "%d%.%d+e%-06, allowed 1e%-08\n$", "symplectic on a group names its form")
+end
 local kref = dm.integrator(kep, {method = "gauss", stages = 3, h = 0.0125}):run(k0, {steps = 160})
 local pass4, p4 = nil, nil
 out = T._capture(function()
