@@ -6,9 +6,9 @@
  * it has removed or reaped it itself.  Whatever is still registered when
  * the process ends is removed (files unlinked, directories emptied one
  * level deep and removed) and killed (SIGKILL to the whole group):
- *   - at exit() -- also `os.exit` from Lua without closing the state --
- *     through an atexit handler installed at the first registration (in a
- *     shared object it runs at dlclose as well);
+ *   - at normal process exit -- also `os.exit` from Lua without closing
+ *     the state -- through an atexit handler installed at the first
+ *     registration (in a shared object it runs at dlclose as well);
  *   - on SIGTERM, SIGHUP and SIGQUIT when the program called
  *     dm_cleanup_catch_signals() (the dmech program does; a host embedding
  *     the library keeps its own signal dispositions and may call

@@ -19,7 +19,7 @@
  * Temporary names are "<dir>/.<name>.<16 hex digits>.tmp", with <name>
  * shortened so that the temporary name fits where the final name fits.
  * The temporary file is registered with core/cleanup.h until it is renamed
- * or removed, so a signal or exit() does not leave it behind.
+ * or removed, so a signal or the process's exit does not leave it behind.
  *
  * Named mode (DM_OUTFILE_NAMED): the data are written by another process
  * that opens o->tmp by name (gnuplot's `set output`).  For a regular target

@@ -174,7 +174,8 @@ static double cc_timeout(void)
  * The compiler runs in a process group of its own: the driver `cc` starts
  * cc1, as, ld; on an interrupt or the timeout the whole group is killed
  * (killing only the driver left cc1 running at full CPU), and the group is
- * registered with core/cleanup.h so that SIGTERM or exit() kill it too.
+ * registered with core/cleanup.h so that SIGTERM or the process's exit
+ * kill it too.
  * Being in its own group, the compiler does not see the terminal's Ctrl-C;
  * dmech's interrupt flag stops it instead. */
 static int run(char *const argv[], char *out, size_t size, int *status,
