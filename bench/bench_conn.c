@@ -1,4 +1,4 @@
-/* bench_conn.c -- connections (doc/connections.md §10):
+/* bench_conn.c -- connections (doc/bundles-connections-holonomy.md §10):
  *
  * 1. Holonomy of a closed 10^4-vertex shape loop by the midpoint discrete
  *    connection, cost per vertex: dmech (dm_conn_dc_holonomy on the

@@ -6,7 +6,7 @@
 -- exactly pi; the net rotation of circles of growing radius is checked
 -- against minus the integral of the curvature over the disc (Stokes); the
 -- discrete horizontal lift converges at first order (euler) and second
--- order (midpoint).  doc/connections.md §2, §8.
+-- order (midpoint).  doc/bundles-connections-holonomy.md §2, §8.
 -- Writes falling_cat.png, falling_cat_snapshots.png and
 -- falling_cat_convergence.png.
 --

@@ -6,8 +6,9 @@
 -- = -2 pi sin L (mod 2 pi): clockwise by 2 pi sin L per day in the north.
 -- The circle is a geodesic N-gon on the frame bundle SO(3) -> S^2, lifted
 -- with the discrete Levi-Civita connection (geodesic edges: exact), so
--- the only error is the polygon's: O(N^-2).  doc/connections.md §7.
--- Writes foucault.png and foucault_convergence.png.
+-- the only error is the polygon's: O(N^-2).
+-- doc/bundles-connections-holonomy.md §7.  Writes foucault.png and
+-- foucault_convergence.png.
 --
 --   src/dmech examples/foucault.lua
 local dm = require "dmech"

@@ -2,7 +2,7 @@
 -- (thesis section 3.12): space is a triangulated disc K', time a uniform grid,
 -- and the potential A is a 1-form on K' x {t_m} in temporal gauge (zero on
 -- the vertical edges).  With the Lorentzian star (+ on horizontal 2-cells,
--- - on vertical ones, doc/dec.md §10), the discrete action
+-- - on vertical ones, doc/exterior-calculus.md §10), the discrete action
 --   S_d(A) = 1/2 sum_m [ dt <d A^m, d A^m>_*2 - (1/dt) |A^{m+1} - A^m|^2_*1 ]
 -- has the Euler-Lagrange equations
 --   *1 (A^{m+1} - 2 A^m + A^{m-1}) / dt^2 = - d1^T *2 d1 A^m

@@ -10,7 +10,8 @@
 -- T = 4 pi/cos b, Lambda = 2 pi (1 - cos b).  The run is the lgvi of the
 -- Lie group integrators; Lambda is computed from the discrete momentum
 -- curve with dm.discrete_connection{bundle = dm.sphere_frames(), rule =
--- "levi-civita"}.  doc/connections.md §8.  Writes rigid_body_phase.png.
+-- "levi-civita"}.  doc/bundles-connections-holonomy.md §8.  Writes
+-- rigid_body_phase.png.
 --
 --   src/dmech examples/rigid_body_phase.lua
 local dm = require "dmech"

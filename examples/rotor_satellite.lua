@@ -4,8 +4,8 @@
 -- A = diag(k_i/I_i) on the bundle SO(3) x T^3 -> T^3.  The group is SO(3):
 -- the result of two loops depends on their order, and a small square of
 -- side a turns the body by exp(-a^2 B(e1, e2)) + O(a^3), B(e1, e2) =
--- -(k1 k2/(I1 I2)) e3 (the curvature).  doc/connections.md §2, §8.
--- Writes rotor_satellite.png.
+-- -(k1 k2/(I1 I2)) e3 (the curvature).
+-- doc/bundles-connections-holonomy.md §2, §8.  Writes rotor_satellite.png.
 --
 --   src/dmech examples/rotor_satellite.lua
 local dm = require "dmech"

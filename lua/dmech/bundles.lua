@@ -7,8 +7,8 @@
 -- its mechanical connection A = I^-1 C, and
 -- dm.discrete_mechanical_connection{bundle = B} its discrete one; the
 -- orbiter carries its connection form instead.  The formulas are those of
--- doc/connections.md §2.  The module returns an installer that the C
--- opener calls with the dm table being built.
+-- doc/bundles-connections-holonomy.md §2.  The module returns an installer that
+-- the C opener calls with the dm table being built.
 return function(dm)
   local Bs = {}
 

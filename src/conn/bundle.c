@@ -1,7 +1,7 @@
 /* bundle.c -- principal bundles: the trivial bundle S x G, the frame
  * bundle SO(3) -> S^2 of the sphere, n particles in R^3 under the diagonal
- * rotation (doc/connections.md §2).  Each is a type object; the dispatch
- * functions at the end check what a type does not provide. */
+ * rotation (doc/bundles-connections-holonomy.md §2).  Each is a type object;
+ * the dispatch functions at the end check what a type does not provide. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
 /* conn.c -- continuous connections on a trivial bundle S x G: the local
  * form, the connection 1-form, horizontal lifts, curvature, and transport
  * and holonomy along shape paths by 4th-order Magnus or adaptive rk8pd
- * (doc/connections.md §3). */
+ * (doc/bundles-connections-holonomy.md §3). */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>

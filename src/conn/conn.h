@@ -2,11 +2,11 @@
  * horizontal lifts, curvature and holonomy, the discrete mechanical
  * connection and the discrete Levi-Civita connection of a triangle mesh
  * (thesis ch. 4; theory, conventions and the corrected formulas in
- * doc/connections.md).
+ * doc/bundles-connections-holonomy.md).
  *
- * Conventions (doc/connections.md §1).  Groups act on the left, g.q.  A
- * trivial bundle Q = S x G stores a point q = (x, g) as the nx shape
- * coordinates followed by the G->nq group coordinates, and h.(x, g) =
+ * Conventions (doc/bundles-connections-holonomy.md §1).  Groups act on the
+ * left, g.q.  A trivial bundle Q = S x G stores a point q = (x, g) as the nx
+ * shape coordinates followed by the G->nq group coordinates, and h.(x, g) =
  * (x, hg).  Body velocity xi = g^-1 gdot.  The local connection form
  * A_loc(x) is a dim x nx matrix (row-major): horizontal motion is
  * g^-1 gdot = -A_loc(x) xdot.  The curvature is

@@ -2,7 +2,7 @@
  * or the mechanical connection A = I^-1 C of a locked inertia I and a
  * coupling C (or of a reduced Lagrangian l(x, xdot, xi)), built
  * symbolically; A and its exact derivatives are compiled to tapes
- * (doc/connections.md §3). */
+ * (doc/bundles-connections-holonomy.md §3). */
 #include <config.h>
 #include <stdlib.h>
 #include <string.h>

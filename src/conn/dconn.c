@@ -1,7 +1,7 @@
 /* dconn.c -- discrete connections: A_d, hor / ver, horizontal lifts,
  * holonomy, the extended pair-groupoid composition, reduction of pairs,
  * the order test and the continuous limit, for any rule (rules.c) on any
- * bundle (doc/connections.md §4-§6). */
+ * bundle (doc/bundles-connections-holonomy.md §4-§6). */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>

@@ -1,6 +1,6 @@
 /* mechanical.c -- the discrete mechanical connection of a G-invariant
- * discrete Lagrangian (doc/connections.md §6.2): A_d(q0, q1) = k^-1 where
- * the discrete momentum J_d(q0, k.q1) = D2 Ld(q0, k.q1) . xi_Q(k.q1)
+ * discrete Lagrangian (doc/bundles-connections-holonomy.md §6.2): A_d(q0, q1) =
+ * k^-1 where the discrete momentum J_d(q0, k.q1) = D2 Ld(q0, k.q1) . xi_Q(k.q1)
  * equals mu (0 for the mechanical connection proper).
  *
  * Symbolically: with fresh symbols k for a group element, L'(k) =

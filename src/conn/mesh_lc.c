@@ -1,8 +1,8 @@
 /* mesh_lc.c -- the discrete Levi-Civita connection of a triangle mesh
- * (doc/connections.md §7): every triangle carries an orthonormal frame of
- * its own plane, built from its edge lengths alone (first vertex at the
- * origin, first edge along e1, the triangle on the side e2 > 0 of it), and
- * crossing a shared edge rotates frames so that the edge keeps its
+ * (doc/bundles-connections-holonomy.md §7): every triangle carries an
+ * orthonormal frame of its own plane, built from its edge lengths alone (first
+ * vertex at the origin, first edge along e1, the triangle on the side e2 > 0 of
+ * it), and crossing a shared edge rotates frames so that the edge keeps its
  * direction.  The product of the transitions around an interior vertex is
  * the rotation by its angle defect (mod 2 pi). */
 #include <config.h>

@@ -2,7 +2,8 @@
  * (a reduced run, or any run whose first columns are shape coordinates):
  * the body transport of its horizontal lift, by a discrete connection
  * (sample to sample) or a continuous one (straight segments between
- * samples); for a closed path the holonomy (doc/connections.md §8). */
+ * samples); for a closed path the holonomy
+ * (doc/bundles-connections-holonomy.md §8). */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>

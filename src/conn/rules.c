@@ -1,7 +1,7 @@
 /* rules.c -- the rules that build discrete connections, as type objects
- * (doc/connections.md §6): from a continuous connection (euler, midpoint,
- * cayley, transport, exact), the trivial connection, a user local
- * representation, the discrete mechanical connection (mechanical.c) and
+ * (doc/bundles-connections-holonomy.md §6): from a continuous connection
+ * (euler, midpoint, cayley, transport, exact), the trivial connection, a user
+ * local representation, the discrete mechanical connection (mechanical.c) and
  * the Levi-Civita connection of the sphere frames.  A new rule is one
  * table here and one line in `rules`. */
 #include <config.h>
@@ -134,7 +134,7 @@ static int mech_local(dm_conn_dc *D, const double *x0, const double *x1, double 
 }
 
 /* trivial bundles go through the local representation (the three
- * properties of doc/connections.md §4 then hold exactly);
+ * properties of doc/bundles-connections-holonomy.md §4 then hold exactly);
  * others solve J_d(q0, k q1) = mu directly */
 static int mech_eval(dm_conn_dc *D, const double *q0, const double *q1, double *g, dm_err *e)
 {

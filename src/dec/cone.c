@@ -1,4 +1,5 @@
-/* cone.c -- the chain homotopy of a collapsible complex (doc/dec.md §10).
+/* cone.c -- the chain homotopy of a collapsible complex
+ * (doc/exterior-calculus.md §10).
  *
  * Greedy elementary collapses (a free face tau of a unique maximal coface
  * sigma, highest dimension first) reduce K to one vertex w; replaying the

@@ -1,4 +1,5 @@
-/* dec.h -- discrete exterior calculus on simplicial complexes (doc/dec.md).
+/* dec.h -- discrete exterior calculus on simplicial complexes
+ * (doc/exterior-calculus.md).
  *
  * Three objects, each immutable once built:
  *
@@ -14,8 +15,8 @@
  *                   complex (a discrete map is two of them).
  *   dm_dec_meshdata a plain vertex/simplex table (generators, files).
  *
- * Conventions (doc/dec.md §1): k-simplices for k < n are stored with
- * increasing vertex indices and numbered in lexicographic order; top
+ * Conventions (doc/exterior-calculus.md §1): k-simplices for k < n are stored
+ * with increasing vertex indices and numbered in lexicographic order; top
  * simplices keep the caller's order and the caller's vertex order, which is
  * their orientation (top_sign = parity relative to the sorted row).  Dual
  * cells are oriented so that orientation(s) ^ orientation(*s) is the
@@ -241,7 +242,7 @@ int dm_dec_derham(const dm_dec_geom *G, int k, dm_dec_fn f, void *ud, double *ou
 
 /* }==== */
 
-/* {==== vector fields, wedge, contraction (doc/dec.md §7-§9) =============== */
+/* {==== vector fields, wedge, contraction (doc/exterior-calculus.md §7-§9) == */
 
 /* Flat of a dual vector field X (one R^N vector per top simplex, N_n x N)
  * to a primal 1-cochain: <X^flat, e> = sum_s (|*e cap s|/|*e|) X(s).e_vec
@@ -288,7 +289,7 @@ int dm_dec_homotopy(const dm_dec_complex *K, dm_sparse **p, int *apex, dm_err *e
 
 /* }==== */
 
-/* {==== maps and nested meshes (doc/dec.md §11, §12) ========================== */
+/* {==== maps and nested meshes (doc/exterior-calculus.md §11, §12) ========= */
 
 /* Push-forward of a dual vector field X (N_n x N1) from geometry G1 to G2
  * of the same complex: J_s X(s), J_s = E2 (E1^T E1)^-1 E1^T the Jacobian of
@@ -339,7 +340,7 @@ void dm_dec_solver_free(dm_dec_solver *F);
 
 /* }==== */
 
-/* {==== mesh files (doc/dec.md §13) ======================================= */
+/* {==== mesh files (doc/exterior-calculus.md §13) ========================== */
 
 /* Read a mesh file: OFF (triangles), Wavefront OBJ (v and triangular f
  * lines), Gmsh .msh ASCII 2.2 or 4.1 (points, lines, triangles, tetrahedra;

@@ -1,6 +1,6 @@
 /* flat.c -- discrete vector fields: the dual-to-primal flat, the
- * renormalised primal-primal sharp (doc/dec.md §7), and the algebraic
- * contraction and Lie derivative of dual forms (§9). */
+ * renormalised primal-primal sharp (doc/exterior-calculus.md §7), and the
+ * algebraic contraction and Lie derivative of dual forms (§9). */
 #include <config.h>
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* geom.c -- the metric of a complex: volumes, circumcentres and signed
- * circumcentric dual volumes (doc/dec.md §3).
+ * circumcentric dual volumes (doc/exterior-calculus.md §3).
  *
  * Everything is computed from squared edge lengths, so the embedded and the
  * intrinsic mode share one code path: inside a top simplex with squared

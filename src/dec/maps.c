@@ -1,7 +1,7 @@
 /* maps.c -- discrete maps between two geometries of one complex: the
  * push-forward of dual vector fields by the Jacobians of the affine maps
- * of the top simplices (doc/dec.md §11); nested refinement transfer
- * operators (§12). */
+ * of the top simplices (doc/exterior-calculus.md §11); nested refinement
+ * transfer operators (§12). */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>

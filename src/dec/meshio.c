@@ -1,6 +1,6 @@
 /* meshio.c -- reading and writing meshes: OFF, Wavefront OBJ, Gmsh .msh
  * (ASCII versions 2.2 and 4.1).  Every defect found while reading names the
- * file, the line and what is wrong (doc/dec.md §13). */
+ * file, the line and what is wrong (doc/exterior-calculus.md §13). */
 #include <config.h>
 #include <errno.h>
 #include <limits.h>

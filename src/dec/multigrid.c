@@ -1,5 +1,5 @@
 /* multigrid.c -- geometric multigrid V-cycles on nested meshes
- * (doc/dec.md §12): Galerkin coarse operators P^T A P, symmetric
+ * (doc/exterior-calculus.md §12): Galerkin coarse operators P^T A P, symmetric
  * Gauss-Seidel smoothing, CHOLMOD on the coarsest level.  Every work array
  * is allocated once by dm_dec_mg_alloc. */
 #include <config.h>

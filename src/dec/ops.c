@@ -1,6 +1,6 @@
 /* ops.c -- Hodge stars, exterior and dual derivatives, codifferential,
  * Laplace-de Rham operators, and the Dirichlet solver for operators of the
- * form diag(w)^-1 S (doc/dec.md §1, §4). */
+ * form diag(w)^-1 S (doc/exterior-calculus.md §1, §4). */
 #include <config.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /* wedge.c -- the primal-primal wedge product with barycentric or
- * circumcentric weights (doc/dec.md §8):
+ * circumcentric weights (doc/exterior-calculus.md §8):
  *
  *   <a ^ b, s> = 1/p! sum over permutations t of (0..p) of
  *                sign(t) w_{t(k)}(s) a([v_t(0)..v_t(k)]) b([v_t(k)..v_t(p)])

@@ -1,6 +1,7 @@
 /* conn_systems.h -- connections written by hand in C for the connection
  * tests (and the holonomy benchmark): their local forms A_loc(x) with
- * exact derivatives, from the closed forms of doc/connections.md.
+ * exact derivatives, from the closed forms of
+ * doc/bundles-connections-holonomy.md.
  *   platform   point mass m at body position (u, v) on a platform of
  *              inertia I: A = m (-v, u)/(I + m rho^2)
  *   cat        the planar three-link cat (three uniform rods of mass 1,

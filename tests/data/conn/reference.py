@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Independent reference values for the connection tests (tests/c/test_conn_*.c,
 tests/lua/conn_*.lua), computed with NumPy/SciPy from the closed forms of
-doc/connections.md, without dmech.  Run: /usr/bin/python3 tests/data/conn/reference.py
+doc/bundles-connections-holonomy.md, without dmech.
+Run: /usr/bin/python3 tests/data/conn/reference.py
 """
 import numpy as np
 from scipy.integrate import quad
