@@ -1,6 +1,8 @@
 /* fields.h -- variational integrators for fields (doc/galerkin.md §4-6):
- * the pseudospectral Schrodinger integrator (schrodinger.c) and the 1-D
- * multiscale finite element method exact at the nodes (msfem.c).
+ * the pseudospectral Schrodinger integrator (schrodinger.c), the 1-D
+ * multiscale finite element method exact at the nodes (msfem.c), and the
+ * multisymplectic integrators of the nonlinear wave equation on space-time
+ * grids (msym.c) and on DEC meshes in space (msym_dec.c).
  *
  * Ownership.  Every _alloc returns a new object in *out that the caller
  * releases with the matching _free (NULL is a no-op); all workspaces are
@@ -24,7 +26,9 @@
 #include <gsl/gsl_vector.h>
 
 #include "core/status.h"
+#include "core/system.h"
 #include "core/trajectory.h"
+#include "dec/dec.h"
 
 /* {==== the pseudospectral Schrodinger integrator ======================== */
 
@@ -122,6 +126,98 @@ typedef struct dm_msfem_problem {
 /* x, U: N + 1 values (the nodes, the nodal values, U[0] = U[N] = 0). */
 int dm_msfem1d(const dm_msfem_problem *P, size_t N, int method, double *x, double *U,
                dm_err *e);
+
+/* }====================================================================== */
+
+/* {==== multisymplectic integrators of the nonlinear wave equation ======= */
+
+/* The Lagrangian density l = u_t^2/2 - c^2 u_x^2/2 - V(u) (sine-Gordon:
+ * V = 1 - cos u; V = 0: the wave equation).  eval fills V, V', V'' at u
+ * (any pointer may be NULL); returns 0, > 0 outside its domain, < 0 on
+ * failure.  A potential with eval == NULL is V = 0. */
+typedef struct dm_potential {
+  int (*eval)(void *data, double u, double *V, double *dV, double *d2V);
+  void *data;
+} dm_potential;
+
+/* A potential whose V(u) is the Lagrangian of a one-coordinate system at
+ * (u, 0): V' = Lq, V'' = Lqq (an expression compiled by src/expr).  ps
+ * holds the system (borrowed) and a work buffer of its work_size bytes,
+ * both the caller's; pot->data points to ps.  Not for two threads at once. */
+typedef struct dm_potential_system {
+  const struct dm_system *field;
+  void *work;
+} dm_potential_system;
+void dm_potential_from_system(dm_potential *pot, dm_potential_system *ps);
+
+/* {---- space-time grids: bilinear elements, one-point rule (msym.c) ----
+ * Nodes x_i = x0 + i dx, dx = length/N: periodic (N nodes) or with both
+ * ends held at their initial values (N + 1 nodes).  Per cell
+ * L_d = dx dt l(u_t, u_x, ubar) with the cell-centre differences and mean
+ * of the four corners; the step is the one-step map (u^j, p^j) ->
+ * (u^{j+1}, p^{j+1}) of the slab's discrete Lagrangian, p^j_i the sum of
+ * the slot derivatives of the two cells of a slab at node i (discrete
+ * Legendre transforms): Newton with the (cyclic) symmetric tridiagonal
+ * Jacobian. */
+typedef struct dm_msym dm_msym;
+
+int dm_msym_alloc(size_t N, double length, int periodic, double c, double dt,
+                  const dm_potential *V, dm_msym **out, dm_err *e);
+void dm_msym_free(dm_msym *M);
+size_t dm_msym_nodes(const dm_msym *M);
+double dm_msym_dx(const dm_msym *M);
+double dm_msym_dt(const dm_msym *M);
+/* The momentum of a velocity field at the start: p = dx v (held nodes 0). */
+void dm_msym_momentum(const dm_msym *M, const double *v, double *p);
+/* One step (outputs may alias inputs). */
+int dm_msym_step(dm_msym *M, const double *u0, const double *p0, double *u1, double *p1,
+                 dm_err *e);
+/* The derivative of the step at (u0, p0) -> (u1, p1) (the step's solution)
+ * applied to (du0, dp0). */
+int dm_msym_tangent(dm_msym *M, const double *u0, const double *u1, const double *du0,
+                    const double *dp0, double *du1, double *dp1, dm_err *e);
+/* The energy sum_i [p_i^2/(2 dx) + dx c^2 ((u_{i+1} - u_i)/dx)^2/2 + dx V(u_i)]. */
+double dm_msym_energy(const dm_msym *M, const double *u, const double *p);
+/* The discrete multisymplectic form formula over n steps from (u, p) with
+ * the first variations (du, dp), (dv, dq): for each cell, the sum over its
+ * four corners of the 2-forms d(D_corner L_d du_corner)(V, W) (an identity:
+ * the Hessian of L_d is symmetric); for each interior node of each level,
+ * the sum of its corner forms over the four cells around it (zero exactly
+ * when V and W solve the linearised scheme); the symplectic form
+ * sum_i (du_i dq_i - dv_i dp_i) of every level against the first.  Maxima
+ * relative to the largest corner form into res[0..3) (cell, node, level). */
+int dm_msym_form_check(dm_msym *M, const double *u, const double *p, const double *du,
+                       const double *dp, const double *dv, const double *dq, long nsteps,
+                       double *res, dm_err *e);
+/* The plane-wave dispersion relation of the scheme (V = 0): the omega with
+ * tan(omega dt/2)/dt = c tan(k dx/2)/dx. */
+double dm_msym_dispersion(const dm_msym *M, double k);
+
+/* {---- DEC meshes in space (msym_dec.c) ----
+ * u a primal 0-cochain on a mesh of any dimension (1-D paths, triangle
+ * meshes, ...), the semi-discrete Lagrangian
+ * l(u, v) = v^T *0 v/2 - c^2 u^T S u/2 - sum_v *0_v V(u_v), S = d0^T *1 d0,
+ * integrated by the midpoint rule in time over each space-time prism:
+ * the step (u^j, p^j) -> (u^{j+1}, p^{j+1}) solves
+ * *0 (u1 - u0)/dt + (dt/2)(c^2 S ubar + *0 V'(ubar)) = p0 by simplified
+ * Newton with the constant SPD matrix *0/dt + (dt/4) c^2 S (CHOLMOD),
+ * p1 = *0 (u1 - u0)/dt - (dt/2)(c^2 S ubar + *0 V'(ubar)).  The mesh is
+ * borrowed; its boundary (if any) carries the natural (Neumann) condition. */
+typedef struct dm_msym_dec dm_msym_dec;
+
+int dm_msym_dec_alloc(const dm_dec_geom *G, double c, double dt, const dm_potential *V,
+                      dm_msym_dec **out, dm_err *e);
+void dm_msym_dec_free(dm_msym_dec *M);
+size_t dm_msym_dec_nodes(const dm_msym_dec *M);
+void dm_msym_dec_momentum(const dm_msym_dec *M, const double *v, double *p);
+/* One step (outputs may alias inputs). */
+int dm_msym_dec_step(dm_msym_dec *M, const double *u0, const double *p0, double *u1,
+                     double *p1, dm_err *e);
+/* The energy p^T *0^{-1} p/2 + c^2 u^T S u/2 + sum *0 V(u). */
+double dm_msym_dec_energy(const dm_msym_dec *M, const double *u, const double *p);
+/* The step's Jacobian applied to (du0, dp0) at (u0 -> u1). */
+int dm_msym_dec_tangent(dm_msym_dec *M, const double *u0, const double *u1, const double *du0,
+                        const double *dp0, double *du1, double *dp1, dm_err *e);
 
 /* }====================================================================== */
 

@@ -205,6 +205,7 @@ void dm_open_dec(lua_State *L);         /* dm.mesh.*, dm.sparse (l_dec*.c) */
 void dm_open_conn(lua_State *L);        /* dm.bundle, dm.connection, ... (l_conn*.c) */
 void dm_open_ensemble(lua_State *L);    /* dm.ensemble, dm.mpi, dm.rng (l_ensemble.c) */
 void dm_open_fields(lua_State *L);      /* dm.schrodinger, field integrators (l_fields.c) */
+void dm_open_wave(lua_State *L);        /* dm.wave: multisymplectic integrators (l_wave.c) */
 
 /* ---- module opener ------------------------------------------------------------ */
 

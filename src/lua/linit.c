@@ -21,6 +21,7 @@ static const dm_opener openers[] = {
   dm_open_conn,
   dm_open_ensemble,
   dm_open_fields,
+  dm_open_wave,
   NULL
 };
 
