@@ -4,7 +4,8 @@
  * it without taking locks or allocating: a slot is claimed with a
  * compare-and-swap (FREE -> BUSY), filled, then published (READY); the
  * handler only touches READY slots and uses only async-signal-safe calls
- * (kill, unlink, rmdir, open, close and the getdents64 system call).
+ * (kill, unlink, rmdir, open, close, nanosleep and the getdents64 system
+ * call).
  */
 #include <config.h>
 #include "core/cleanup.h"
@@ -16,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/syscall.h>
+#include <time.h>
 #include <unistd.h>
 
 enum { FREE = 0, BUSY, READY };
@@ -29,6 +31,8 @@ typedef struct slot {
 } slot;
 
 static slot slots[DM_CLEANUP_SLOTS];
+static int holding;              /* threads between hold and release (atomic) */
+static const int fatal_sigs[] = { SIGTERM, SIGHUP, SIGQUIT };
 static pthread_once_t atexit_once = PTHREAD_ONCE_INIT;
 
 static void run_at_exit(void)
@@ -78,6 +82,23 @@ int dm_cleanup_add_pgroup(pid_t pgid)
   return pgid > 1 ? add(KIND_PGROUP, NULL, pgid) : -1;
 }
 
+void dm_cleanup_hold(sigset_t *old)
+{
+  sigset_t set;
+  size_t i;
+  sigemptyset(&set);
+  for (i = 0; i < sizeof fatal_sigs / sizeof fatal_sigs[0]; i++)
+    sigaddset(&set, fatal_sigs[i]);
+  pthread_sigmask(SIG_BLOCK, &set, old);
+  __atomic_add_fetch(&holding, 1, __ATOMIC_ACQ_REL);
+}
+
+void dm_cleanup_release(const sigset_t *old)
+{
+  __atomic_sub_fetch(&holding, 1, __ATOMIC_ACQ_REL);
+  pthread_sigmask(SIG_SETMASK, old, NULL);
+}
+
 void dm_cleanup_drop(int i)
 {
   if (i >= 0 && i < DM_CLEANUP_SLOTS)
@@ -118,6 +139,13 @@ static void empty_dir(const char *dir)
 void dm_cleanup_run(void)
 {
   int i, errsave = errno;
+  /* a child started by another thread but not registered yet would be
+   * missed: let that thread finish registering (it runs with our signals
+   * blocked, so this never waits for the thread it interrupted) */
+  for (i = 0; i < 2000 && __atomic_load_n(&holding, __ATOMIC_ACQUIRE) > 0; i++) {
+    struct timespec ts = { 0, 1000000L };
+    nanosleep(&ts, NULL);
+  }
   /* processes first: a compiler must not write into a directory being
    * removed */
   for (i = 0; i < DM_CLEANUP_SLOTS; i++)
@@ -149,16 +177,15 @@ static void on_fatal_signal(int sig)
 
 void dm_cleanup_catch_signals(void)
 {
-  static const int sigs[] = { SIGTERM, SIGHUP, SIGQUIT };
   size_t i;
-  for (i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+  for (i = 0; i < sizeof fatal_sigs / sizeof fatal_sigs[0]; i++) {
     struct sigaction sa, old;
-    if (sigaction(sigs[i], NULL, &old) != 0 || old.sa_handler == SIG_IGN)
+    if (sigaction(fatal_sigs[i], NULL, &old) != 0 || old.sa_handler == SIG_IGN)
       continue;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_fatal_signal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESETHAND;
-    sigaction(sigs[i], &sa, NULL);
+    sigaction(fatal_sigs[i], &sa, NULL);
   }
 }

@@ -18,12 +18,19 @@
  * DM_CLEANUP_PATH_MAX; beyond them registration returns -1 and the caller
  * goes on without the guarantee.
  *
+ * A child or file exists before it can be registered.  So that SIGTERM in
+ * between does not leak it, create and register between dm_cleanup_hold
+ * and dm_cleanup_release: the signals above are blocked in the calling
+ * thread (give the child the mask `old` back), and dm_cleanup_run in any
+ * other thread first waits (up to 2 s) until no thread is held.
+ *
  * Thread safety: registration and dropping may happen from any thread
  * (slots are claimed atomically); dm_cleanup_run is async-signal-safe.
  */
 #ifndef DM_CLEANUP_H
 #define DM_CLEANUP_H
 
+#include <signal.h>
 #include <sys/types.h>
 
 #define DM_CLEANUP_SLOTS 32
@@ -34,11 +41,17 @@ int dm_cleanup_add_file(const char *path);
 int dm_cleanup_add_dir(const char *path);
 int dm_cleanup_add_pgroup(pid_t pgid);
 
+/* Around creating something and registering it (see above); *old
+ * receives the thread's previous signal mask, to be passed back. */
+void dm_cleanup_hold(sigset_t *old);
+void dm_cleanup_release(const sigset_t *old);
+
 /* Forget a registration (slot < 0 is a no-op). */
 void dm_cleanup_drop(int slot);
 
 /* Kill every registered process group, remove every registered file and
- * directory, forget them all.  Async-signal-safe. */
+ * directory, forget them all; first wait (at most 2 s) while another
+ * thread is between hold and release.  Async-signal-safe. */
 void dm_cleanup_run(void);
 
 /* Install handlers for SIGTERM, SIGHUP and SIGQUIT (those not ignored)

@@ -323,10 +323,16 @@ static int compile_native(const dm_tape *t, const double *in0,
   const char *tmpd = env ? env->tmpdir : getenv("TMPDIR");
   char dir[4096], obj[4200];
   snprintf(dir, sizeof dir, "%s/dmech-XXXXXX", tmpd && *tmpd ? tmpd : "/tmp");
-  if (mkdtemp(dir) == NULL)
+  sigset_t held;
+  dm_cleanup_hold(&held);                  /* no SIGTERM before it is registered */
+  if (mkdtemp(dir) == NULL) {
+    int e = errno;
+    dm_cleanup_release(&held);
     return dm_err_set(err, DM_EIO, "native: mkdtemp in %s: %s",
-                      tmpd && *tmpd ? tmpd : "/tmp", strerror(errno));
+                      tmpd && *tmpd ? tmpd : "/tmp", strerror(e));
+  }
   int dslot = dm_cleanup_add_dir(dir);     /* removed at exit or SIGTERM too */
+  dm_cleanup_release(&held);
   s = dm_native__build_units(ccargv, ncc, dir, srcs->src, srcs->n, opt, parallelism(),
                              obj, sizeof obj, err);
   if (s == DM_OK) {

@@ -193,10 +193,17 @@ static int run(char *const argv[], char *out, size_t size, int *status,
   posix_spawn_file_actions_addclose(&fa, fd[0]);
   posix_spawn_file_actions_addclose(&fa, fd[1]);
   posix_spawnattr_init(&attr);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
   posix_spawnattr_setpgroup(&attr, 0);
+  /* a SIGTERM between the spawn and the registration would leave the
+   * group running: hold it back until the group is registered */
+  sigset_t held;
+  dm_cleanup_hold(&held);
+  posix_spawnattr_setsigmask(&attr, &held);
   pid_t pid;
   int rc = posix_spawnp(&pid, argv[0], &fa, &attr, argv, environ);
+  int slot = rc == 0 ? dm_cleanup_add_pgroup(pid) : -1;
+  dm_cleanup_release(&held);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&attr);
   close(fd[1]);
@@ -206,7 +213,6 @@ static int run(char *const argv[], char *out, size_t size, int *status,
                       "native: cannot run C compiler '%s': %s", argv[0],
                       strerror(rc));
   }
-  int slot = dm_cleanup_add_pgroup(pid);
   size_t len = 0;
   int result = DM_OK, ws = 0, open = 1;
   double t0 = now(), limit = cc_timeout();

@@ -289,6 +289,47 @@ static void test_stopped_compiler(void)
          "child with it");
   tap_is_int(count_build_dirs(), dirs0, "... and removes its build directory");
 
+  /* SIGTERM after the compiler exists but before its group is registered:
+   * the window forced wide open, with a plain child in its own group */
+  int sync[2];
+  if (pipe(sync) != 0)
+    sync[0] = sync[1] = -1;
+  child = fork();
+  if (child == 0) {
+    sigset_t held, pend;
+    dm_cleanup_catch_signals();
+    dm_cleanup_hold(&held);
+    pid_t g = fork();
+    if (g == 0) {
+      setpgid(0, 0);
+      sigprocmask(SIG_SETMASK, &held, NULL);
+      execlp("sleep", "sleep", "300", (char *)NULL);
+      _exit(127);
+    }
+    setpgid(g, g);
+    if (write(sync[1], &g, sizeof g) != (ssize_t)sizeof g)
+      _exit(2);
+    for (int i = 0; i < 30000; i++) {      /* until SIGTERM is pending */
+      sigpending(&pend);
+      if (sigismember(&pend, SIGTERM))
+        break;
+      sleep_ms(1);
+    }
+    dm_cleanup_add_pgroup(g);
+    dm_cleanup_release(&held);               /* SIGTERM is delivered here */
+    _exit(0);
+  }
+  grandchild = -1;
+  if (read(sync[0], &grandchild, sizeof grandchild) != (ssize_t)sizeof grandchild)
+    grandchild = -1;
+  close(sync[0]);
+  close(sync[1]);
+  kill(child, SIGTERM);
+  waitpid(child, &ws, 0);
+  tap_ok(WIFSIGNALED(ws) && WTERMSIG(ws) == SIGTERM, "SIGTERM between starting "
+         "a child and registering it: held back, then the process dies of it");
+  tap_ok(grandchild > 0 && gone(grandchild), "... and the child's group is killed");
+
   /* compilers that fail or crash */
   write_fakecc("fail");
   st = dm_native_compile(t, NULL, NULL, &nat, &err);
