@@ -182,7 +182,7 @@ static int run(char *const argv[], char *out, size_t size, int *status,
                dm_err *err)
 {
   int fd[2];
-  if (pipe(fd) != 0)
+  if (pipe2(fd, O_CLOEXEC) != 0)
     return dm_err_set(err, DM_EIO, "native: pipe: %s", strerror(errno));
   posix_spawn_file_actions_t fa;
   posix_spawnattr_t attr;
@@ -190,8 +190,15 @@ static int run(char *const argv[], char *out, size_t size, int *status,
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_adddup2(&fa, fd[1], 1);
   posix_spawn_file_actions_adddup2(&fa, fd[1], 2);
+  /* the compiler gets stdio and nothing else: a descriptor another thread
+   * has open without close-on-exec (HDF5 opens its files so, with an
+   * exclusive flock) must not stay open, and locked, until cc exits */
+#if HAVE_POSIX_SPAWN_FILE_ACTIONS_ADDCLOSEFROM_NP
+  posix_spawn_file_actions_addclosefrom_np(&fa, 3);
+#else
   posix_spawn_file_actions_addclose(&fa, fd[0]);
   posix_spawn_file_actions_addclose(&fa, fd[1]);
+#endif
   posix_spawnattr_init(&attr);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
   posix_spawnattr_setpgroup(&attr, 0);

@@ -155,6 +155,12 @@ int gp_spawn(dm_gp_session *s, dm_err *e)
   posix_spawn_file_actions_adddup2(&fa, in[0], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&fa, out[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&fa, err[1], STDERR_FILENO);
+#if HAVE_POSIX_SPAWN_FILE_ACTIONS_ADDCLOSEFROM_NP
+  /* nothing but stdio: a file another thread has open without
+   * close-on-exec (HDF5 files, with their flock) must not stay open, and
+   * locked, as long as gnuplot runs */
+  posix_spawn_file_actions_addclosefrom_np(&fa, 3);
+#endif
   posix_spawnattr_init(&at);
   posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF
                                 | POSIX_SPAWN_SETSIGMASK);

@@ -8,6 +8,7 @@
 #include <config.h>
 
 #include <errno.h>
+#include <fcntl.h>
 #include <locale.h>
 #include <signal.h>
 #include <stdio.h>
@@ -689,6 +690,30 @@ static void test_free_reaps(void)
   dm_gp_session_free(NULL);
 }
 
+/* A descriptor open without close-on-exec (as HDF5 opens its files, with
+ * a flock) is not passed on to gnuplot. */
+static void test_no_inherited_fds(void)
+{
+  dm_gp_session *s = dm_gp_session_alloc();
+  dm_err e;
+  char link[64], target[256];
+  int fd = open("/dev/null", O_RDONLY), rc;
+  ssize_t n0 = -1, n = -1;
+  int err = 0;
+  rc = dm_gp_start(s, &e);
+  if (rc == DM_OK) {
+    snprintf(link, sizeof link, "/proc/%ld/fd/0", (long)dm_gp_pid(s));
+    n0 = readlink(link, target, sizeof target - 1);     /* /proc works */
+    snprintf(link, sizeof link, "/proc/%ld/fd/%d", (long)dm_gp_pid(s), fd);
+    n = readlink(link, target, sizeof target - 1);
+    err = errno;
+  }
+  tap_ok(rc == DM_OK && fd > 2 && n0 > 0 && n < 0 && err == ENOENT,
+         "gnuplot gets stdio, not descriptor %d of ours", fd);
+  dm_gp_session_free(s);
+  close(fd);
+}
+
 /* }==== */
 
 int main(void)
@@ -740,5 +765,6 @@ int main(void)
   test_missing();
   test_log();
   test_free_reaps();
+  test_no_inherited_fds();
   return tap_done();
 }

@@ -212,6 +212,8 @@ static void test_damaged_cache(void)
 
 /* {==== a compiler that has to be stopped ================================== */
 
+static int probe_fd = -1;       /* the descriptor the "fds" compiler looks for */
+
 static void write_fakecc(const char *mode)
 {
   FILE *f = fopen(fakecc, "w");
@@ -221,6 +223,11 @@ static void write_fakecc(const char *mode)
     fprintf(f, "echo 'f.c:1:1: error: the fake compiler refuses' >&2; exit 1\n");
   else if (strcmp(mode, "crash") == 0)
     fprintf(f, "kill -SEGV $$\n");
+  else if (strcmp(mode, "fds") == 0)
+    fprintf(f, "[ -e /proc/$$/fd/1 ] || { echo 'no /proc' >&2; exit 1; }\n"
+               "if [ -e /proc/$$/fd/%d ]; then echo 'descriptor %d: inherited' >&2;\n"
+               "else echo 'descriptor %d: closed' >&2; fi; exit 1\n",
+            probe_fd, probe_fd, probe_fd);
   else
     fprintf(f, "sleep 300 &\necho $! > '%s'\nwait\n", pidfile);
   fclose(f);
@@ -341,6 +348,17 @@ static void test_stopped_compiler(void)
   tap_ok(st == DM_EFAILED && strstr(err.msg, "exit 139"),
          "crashing compiler: DM_EFAILED, exit 128 + SIGSEGV (%s)", err.msg);
   tap_is_int(count_build_dirs(), dirs0, "no build directory left");
+
+  /* a descriptor another thread has open without close-on-exec (HDF5
+   * opens its files so, with a flock) is not passed to the compiler */
+  probe_fd = open("/dev/null", O_RDONLY);
+  write_fakecc("fds");
+  st = dm_native_compile(t, NULL, NULL, &nat, &err);
+  close(probe_fd);
+  char want[64];
+  snprintf(want, sizeof want, "descriptor %d: closed", probe_fd);
+  tap_ok(st == DM_EFAILED && strstr(err.msg, want) != NULL,
+         "the compiler gets stdio, no other descriptor (%s)", err.msg);
 
   /* and the real compiler still works afterwards */
   unsetenv("CC");
