@@ -4,8 +4,16 @@
 -- recipe over dm.plot.  The module returns an installer that the C opener
 -- calls with the dm table being built.
 return function(dm)
+  -- errors point at the caller's line: the first frame outside this file
+  local here = debug.getinfo(1, "S").source
   local function fail(fmt, ...)
-    error("dm.plot_convergence: " .. string.format(fmt, ...), 3)
+    local msg, level = "dm.plot_convergence: " .. string.format(fmt, ...), 2
+    while true do
+      local info = debug.getinfo(level, "S")
+      if info == nil then error(msg, 0) end
+      if info.source ~= here then error(msg, level) end
+      level = level + 1
+    end
   end
 
   local function values(x, what)

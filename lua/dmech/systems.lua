@@ -10,6 +10,21 @@
 -- constructors; the functions use dm only when called.
 return function(dm, C)
   local S = {}
+
+  -- Errors point at the caller's line, however deep in this file they
+  -- are raised (the helpers nest): the first frame outside this file (a C
+  -- caller such as pcall gets none).  A fixed level put "systems.lua:289:"
+  -- in front of messages when an entry went through two helpers.
+  local here = debug.getinfo(1, "S").source
+  local function raise(msg)
+    local level = 2
+    while true do
+      local info = debug.getinfo(level, "S")
+      if info == nil then error(msg, 0) end
+      if info.source ~= here then error(msg, level) end
+      level = level + 1
+    end
+  end
   C = C or {}
 
   -- Parameters in a fixed order from defaults, overridden by opts; the
@@ -18,15 +33,15 @@ return function(dm, C)
   local function params(fname, opts, defaults, extra)
     opts = opts or {}
     if type(opts) ~= "table" then
-      error(("dm.systems.%s: table of parameters expected, got %s"):format(fname, type(opts)), 3)
+      raise(("dm.systems.%s: table of parameters expected, got %s"):format(fname, type(opts)))
     end
     extra = extra or {}
     if opts.impl ~= nil and opts.impl ~= "traced" and not C[fname] then
       local have = {}
       for k in pairs(C) do have[#have + 1] = k end
       table.sort(have)
-      error(("dm.systems.%s: no C implementation (impl = \"c\" exists for %s)"):format(fname,
-        table.concat(have, ", ")), 3)
+      raise(("dm.systems.%s: no C implementation (impl = \"c\" exists for %s)"):format(fname,
+        table.concat(have, ", ")))
     end
     local known, list, ex = {impl = true}, {}, {}
     for _, d in ipairs(defaults) do known[d[1]] = true end
@@ -37,19 +52,19 @@ return function(dm, C)
         for _, d in ipairs(defaults) do names[#names + 1] = d[1] end
         for _, e in ipairs(extra) do names[#names + 1] = e end
         names[#names + 1] = "impl"
-        error(("dm.systems.%s: unknown parameter %s (parameters: %s)"):format(fname, tostring(k),
-          table.concat(names, ", ")), 3)
+        raise(("dm.systems.%s: unknown parameter %s (parameters: %s)"):format(fname, tostring(k),
+          table.concat(names, ", ")))
       end
     end
     for _, d in ipairs(defaults) do
       local v = opts[d[1]]
       if v == nil then v = d[2] end
       if type(v) ~= "number" then
-        error(("dm.systems.%s: parameter %s must be a number, got %s"):format(fname, d[1], type(v)), 3)
+        raise(("dm.systems.%s: parameter %s must be a number, got %s"):format(fname, d[1], type(v)))
       end
       if v ~= v or v == math.huge or v == -math.huge then
-        error(("dm.systems.%s: parameter %s must be finite, got %s"):format(fname, d[1],
-          v ~= v and "nan" or v > 0 and "inf" or "-inf"), 3)
+        raise(("dm.systems.%s: parameter %s must be finite, got %s"):format(fname, d[1],
+          v ~= v and "nan" or v > 0 and "inf" or "-inf"))
       end
       list[#list + 1] = {d[1], v}
     end
@@ -63,7 +78,7 @@ return function(dm, C)
     local which = ex.impl or "traced"
     if which == "traced" then return nil end
     if which ~= "c" then
-      error(("dm.systems.%s: impl must be \"traced\" or \"c\", got %s"):format(fname, tostring(which)), 3)
+      raise(("dm.systems.%s: impl must be \"traced\" or \"c\", got %s"):format(fname, tostring(which)))
     end
     local t = {}
     for _, d in ipairs(list) do t[d[1]] = d[2] end
@@ -110,7 +125,7 @@ return function(dm, C)
     function(o)
       local p, ex = params("kepler", o, {{"mu", 1}}, {"dim"})
       local dim = ex.dim or 2
-      if dim ~= 2 and dim ~= 3 then error("dm.systems.kepler: dim must be 2 or 3", 2) end
+      if dim ~= 2 and dim ~= 3 then raise("dm.systems.kepler: dim must be 2 or 3") end
       local c = impl("kepler", ex, p)
       if c then return c end
       local coords = dim == 2 and {"x", "y"} or {"x", "y", "z"}
@@ -187,7 +202,7 @@ return function(dm, C)
       local p, ex = params("spherical_pendulum_r3", o, {{"g", 9.81}, {"l", 1}, {"m", 1}}, {"form"})
       local form = ex.form or "squared"
       if form ~= "squared" and form ~= "norm" then
-        error("dm.systems.spherical_pendulum_r3: form must be \"squared\" or \"norm\"", 2)
+        raise("dm.systems.spherical_pendulum_r3: form must be \"squared\" or \"norm\"")
       end
       local c = impl("spherical_pendulum_r3", ex, p)
       if c then return c end
@@ -211,7 +226,7 @@ return function(dm, C)
       local p, ex = params("double_spherical_pendulum", o, dsp_params, {"form"})
       local shape = (ex.form or "cylindrical") == "shape"
       if ex.form and ex.form ~= "shape" and ex.form ~= "cylindrical" then
-        error("dm.systems.double_spherical_pendulum: form must be \"cylindrical\" or \"shape\"", 2)
+        raise("dm.systems.double_spherical_pendulum: form must be \"cylindrical\" or \"shape\"")
       end
       return dm.system{name = "double spherical pendulum", params = p,
         coords = shape and {"theta", "r1", "r2", "phi"} or {"r1", "theta1", "r2", "theta2"},
@@ -260,11 +275,13 @@ return function(dm, C)
     local p, ex = params(fname, o, defaults, {"n", "ends"})
     local n = ex.n or 32
     if math.type(n) ~= "integer" or n < 2 then
-      error(("dm.systems.%s: n must be an integer >= 2, got %s"):format(fname, tostring(ex.n)), 3)
+      raise(("dm.systems.%s: n must be an integer >= 2, got %s"):format(fname, tostring(ex.n)))
+    elseif n > 1000000 then
+      raise(("dm.systems.%s: n = %d is too many (at most 1000000)"):format(fname, n))
     end
     local ends = ex.ends or "fixed"
     if ends ~= "fixed" and ends ~= "periodic" then
-      error(("dm.systems.%s: ends must be \"fixed\" or \"periodic\", got %s"):format(fname, tostring(ends)), 3)
+      raise(("dm.systems.%s: ends must be \"fixed\" or \"periodic\", got %s"):format(fname, tostring(ends)))
     end
     return p, n, ends
   end
@@ -302,7 +319,7 @@ return function(dm, C)
     "Toda lattice of n particles (coordinates x[1..n]): L = sum m v_i^2/2 - sum_bonds (a/b) exp(-b r), r = x_{i+1} - x_i (periodic: the bond x_1 - x_n closes the ring, where the lattice is completely integrable: the traces of the powers of its Lax matrix are conserved, see dm.systems.toda_integrals); with fixed ends x_0 = x_{n+1} = 0.",
     function(o)
       local p, n, ends = chain_opts("toda", o, {{"a", 1}, {"b", 1}, {"m", 1}})
-      if o == nil or o.ends == nil then ends = "periodic" end
+      if type(o) ~= "table" or o.ends == nil then ends = "periodic" end
       return dm.system{name = "Toda lattice", coords = dm.coords("x", n), params = p,
         L = function(q, v, p)
           local T, V = 0, 0
@@ -320,7 +337,34 @@ return function(dm, C)
   -- (L^k)_jj from k products with the unit vector e_j, whose support stays
   -- within k sites of j: O(n k^2) in all.
   function S.toda_integrals(q, p, kmax, o)
+    local function numbers(x, what)
+      if type(x) ~= "table" or #x < 2 then
+        raise(("dm.systems.toda_integrals: %s must be a list of at least 2 numbers, got %s")
+          :format(what, type(x)))
+      end
+      for i = 1, #x do
+        if type(x[i]) ~= "number" then
+          raise(("dm.systems.toda_integrals: %s[%d] must be a number, got %s"):format(what, i, type(x[i])))
+        end
+      end
+    end
+    numbers(q, "q")
+    numbers(p, "p")
+    if #p ~= #q then
+      raise(("dm.systems.toda_integrals: q and p must have the same length, got %d and %d"):format(#q, #p))
+    end
+    if kmax ~= nil and (math.type(kmax) ~= "integer" or kmax < 1 or kmax > 64) then
+      raise(("dm.systems.toda_integrals: kmax must be an integer from 1 to 64, got %s"):format(tostring(kmax)))
+    end
+    if o ~= nil and type(o) ~= "table" then
+      raise(("dm.systems.toda_integrals: parameters {a=, b=, m=} expected, got %s"):format(type(o)))
+    end
     o = o or {}
+    for _, k in ipairs{"a", "b", "m"} do
+      if o[k] ~= nil and (type(o[k]) ~= "number" or not (o[k] > 0) or o[k] == math.huge) then
+        raise(("dm.systems.toda_integrals: %s must be a positive finite number"):format(k))
+      end
+    end
     local n, a, b, m = #q, o.a or 1, o.b or 1, o.m or 1
     kmax = kmax or 4
     local kappa = -math.sqrt(b / (4 * m * a))
@@ -355,18 +399,28 @@ return function(dm, C)
     "Newtonian N-body problem, n bodies in the plane (dim = 2: coordinates x[1..n], y[1..n]) or in space (dim = 3: and z[1..n]): L = sum m_i |v_i|^2/2 + sum_{i<j} G m_i m_j / sqrt(|q_i - q_j|^2 + soft^2); masses m_i (default 1) are parameters m1 .. mn; momentum and angular momentum are conserved.",
     function(o)
       o = o or {}
+      if type(o) ~= "table" then
+        raise(("dm.systems.nbody: table of parameters expected, got %s"):format(type(o)))
+      end
       local n, dim, masses = o.n or 3, o.dim or 2, o.masses
       local rest = {}
       for k, v in pairs(o) do if k ~= "n" and k ~= "dim" and k ~= "masses" then rest[k] = v end end
       local p = params("nbody", rest, {{"G", 1}, {"soft", 0}})
       if math.type(n) ~= "integer" or n < 2 then
-        error(("dm.systems.nbody: n must be an integer >= 2, got %s"):format(tostring(o.n)), 2)
+        raise(("dm.systems.nbody: n must be an integer >= 2, got %s"):format(tostring(o.n)))
+      elseif n > 100000 then
+        raise(("dm.systems.nbody: n = %d is too many (at most 100000)"):format(n))
       end
       if dim ~= 2 and dim ~= 3 then
-        error(("dm.systems.nbody: dim must be 2 or 3, got %s"):format(tostring(dim)), 2)
+        raise(("dm.systems.nbody: dim must be 2 or 3, got %s"):format(tostring(dim)))
       end
       if masses ~= nil and (type(masses) ~= "table" or #masses ~= n) then
-        error(("dm.systems.nbody: masses must be a list of %d numbers"):format(n), 2)
+        raise(("dm.systems.nbody: masses must be a list of %d numbers"):format(n))
+      end
+      for i = 1, masses and n or 0 do
+        if type(masses[i]) ~= "number" then
+          raise(("dm.systems.nbody: masses[%d] must be a number, got %s"):format(i, type(masses[i])))
+        end
       end
       for i = 1, n do p[#p + 1] = {"m" .. i, masses and masses[i] or 1} end
       local axes = dim == 2 and {"x", "y"} or {"x", "y", "z"}
@@ -397,7 +451,9 @@ return function(dm, C)
       local p, ex = params("string", o, {{"density", 1}, {"length", 1}, {"tension", 1}}, {"n"})
       local n = ex.n or 64
       if math.type(n) ~= "integer" or n < 1 then
-        error(("dm.systems.string: n must be an integer >= 1, got %s"):format(tostring(ex.n)), 2)
+        raise(("dm.systems.string: n must be an integer >= 1, got %s"):format(tostring(ex.n)))
+      elseif n > 1000000 then
+        raise(("dm.systems.string: n = %d is too many (at most 1000000)"):format(n))
       end
       return dm.system{name = "nonlinear string", coords = dm.coords("u", n), params = p,
         L = function(q, v, p)
