@@ -211,8 +211,8 @@ int dm_outfile_open(dm_outfile *o, const char *path, const char *what,
   if (o->through && (flags & DM_OUTFILE_NAMED)) {
     size_t n;
     if (privdir == NULL) {
-      st = dm_err_set(e, DM_EINVAL, "%s '%.200s': no private directory for "
-                      "the temporary file", o->what, path);
+      st = dm_err_set(e, DM_EINVAL, "%s '%.200s': is %s; this format needs a "
+                      "regular file", o->what, path, dm_outfile_kind(o->target));
       goto fail;
     }
     n = strlen(privdir) + 16;

@@ -18,6 +18,7 @@
 #include <hdf5.h>
 
 #include "core/interrupt.h"
+#include "core/outfile.h"
 #include "core/mpi.h"
 
 #if defined(H5_HAVE_PARALLEL) && defined(DM_HAVE_MPI)
@@ -349,18 +350,18 @@ static hid_t ordered_fcpl(void)
 
 int dm_traj_save_h5(const dm_traj *tr, const char *path, dm_err *e)
 {
-  char *tmp;
+  dm_outfile o;                 /* core/outfile.h: what may be replaced */
   hid_t fcpl, f;
   int st;
   if (path == NULL || path[0] == '\0')
     return dm_err_set(e, DM_EINVAL, "save: empty file name");
   if ((st = check_names(tr, path, e)) != DM_OK)
     return st;
-  if ((tmp = temp_name(path, e)) == NULL)
-    return e != NULL ? e->status : DM_EIO;
+  if ((st = dm_outfile_open(&o, path, "saving", DM_OUTFILE_NAMED, NULL, e)) != DM_OK)
+    return st;
   lock();
   fcpl = ordered_fcpl();
-  f = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
+  f = H5Fcreate(o.tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
   if (f < 0)
     st = h5_fail(e, DM_EIO, path, "cannot create the HDF5 file");
   else
@@ -370,12 +371,11 @@ int dm_traj_save_h5(const dm_traj *tr, const char *path, dm_err *e)
   if (fcpl >= 0)
     H5Pclose(fcpl);
   unlock();
-  if (st == DM_OK)
-    st = publish(tmp, path, e);
-  if (st != DM_OK)
-    unlink(tmp);
-  free(tmp);
-  return st;
+  if (st != DM_OK) {
+    dm_outfile_abandon(&o);
+    return st;
+  }
+  return dm_outfile_commit(&o, e);
 }
 
 /* }====================================================================== */
