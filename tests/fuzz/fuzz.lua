@@ -15,6 +15,8 @@
 -- "-nan", "(null)", a path inside dmech's Lua library (an internal error
 -- leaking out) or a traceback.  A reader's error must name the file.
 -- Every failure is written to $FUZZ_OUT as a case for tests/data/fuzz/.
+-- $FUZZ_TIME_LIMIT (0.5 s) and $FUZZ_HARD_LIMIT (20 s more) bound a call,
+-- $FUZZ_MEMORY_MB (4096; 0: none) the address space.
 -- Output is TAP; the script returns the exit status.
 local dm = require "dmech"
 local here = (arg and arg[0] or "tests/fuzz/fuzz.lua"):match("^(.*)/[^/]*$") or "."
@@ -462,7 +464,8 @@ end
 
 local mode = ...
 local a2, a3 = select(2, ...)
-if host then host.limit_memory(4096) end
+local mem = tonumber(os.getenv("FUZZ_MEMORY_MB") or "") or 4096
+if host and mem > 0 then host.limit_memory(mem) end
 if mode == "api" then
   fuzz_api(tonumber(a2) or 1000, a3 or "1")
 elseif mode == "files" then

@@ -6,8 +6,8 @@
  *   fuzz.call(seconds, f, ...) -> ok, results... | false, error
  *       pcall with a time limit: after `seconds` the interrupt flag is
  *       raised (C loops stop with DM_EINTR) and a hook stops Lua code with
- *       the error "fuzz: time limit"; a call still running 20 s later is a
- *       hang: "HANG" is written to stderr and the process exits with 3
+ *       the error "fuzz: time limit"; a call still running 20 s later
+ *       ($FUZZ_HARD_LIMIT) is a hang: "HANG" is written to stderr and the process exits with 3
  *       (the driver has written the reproducer of the call beforehand).
  *   fuzz.limit_memory(megabytes)  address-space limit (setrlimit), so an
  *       allocation bomb fails instead of swapping; a no-op under
@@ -44,7 +44,8 @@
 #define FUZZ_ASAN 1
 #endif
 
-#define HARD_LIMIT 20         /* seconds after the soft limit */
+#define HARD_LIMIT 20         /* seconds after the soft limit ($FUZZ_HARD_LIMIT) */
+static long hard_limit = HARD_LIMIT;
 
 static lua_State *hookL;
 static volatile sig_atomic_t stage;    /* 0 idle, 1 armed, 2 soft limit hit */
@@ -59,7 +60,7 @@ static void stop_hook(lua_State *L, lua_Debug *ar)
 static void on_alarm(int sig)
 {
   static const char msg[] = "HANG: a call ran past the hard time limit\n";
-  struct itimerval it = {{0, 0}, {HARD_LIMIT, 0}};
+  struct itimerval it = {{0, 0}, {hard_limit, 0}};
   (void)sig;
   if (stage == 1) {
     stage = 2;
@@ -171,6 +172,8 @@ int main(int argc, char **argv)
   lua_State *L;
   int i, st, code = 0;
   struct sigaction sa;
+  if (getenv("FUZZ_HARD_LIMIT") != NULL && atol(getenv("FUZZ_HARD_LIMIT")) > 0)
+    hard_limit = atol(getenv("FUZZ_HARD_LIMIT"));
   if (argc < 2) {
     fprintf(stderr, "usage: %s fuzz.lua mode [args...]\n", argv[0]);
     return 2;
