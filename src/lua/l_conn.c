@@ -3,8 +3,10 @@
  *   B = dm.bundle{system = sys, acts_on = {"theta"}}          -- from a dm.system
  *   B = dm.bundle{name = "platform", I = 1, m = 1}            -- the catalog (dm.bundles)
  *   S = dm.sphere_frames() ; P = dm.bundle{name = "particles", n = 4}
- *   q = B:point{x = {0.5, 0}, g = 0} ; q.x ; q.g ; B:act(g, q) ...
- * and the shared readers of l_conn.h.  See l_conn.h. */
+ *   q = B:point{x = {0.5, 0}, g = 0} ; B:proj(q) ; B:act(g, q) ...
+ * the reduced Lagrangian a bundle carries, and the columns of a trajectory
+ * that sample its shape.  Points: l_conn_point.c; the readers the
+ * connection bindings share: l_conn_args.c.  See l_conn.h. */
 #include <config.h>
 #include <math.h>
 #include <stdlib.h>
@@ -14,228 +16,6 @@
 #include "lua/l_expr.h"
 #include "lua/l_system.h"
 #include "core/trajectory.h"
-
-/* {==== helpers ============================================================= */
-
-void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known)
-{
-  idx = lua_absindex(L, idx);
-  lua_pushnil(L);
-  while (lua_next(L, idx) != 0) {
-    int ok = 0;
-    size_t k;
-    lua_pop(L, 1);
-    if (lua_type(L, -1) == LUA_TSTRING)
-      for (k = 0; known[k] != NULL && !ok; k++)
-        ok = strcmp(lua_tostring(L, -1), known[k]) == 0;
-    if (!ok) {
-      luaL_Buffer b;
-      luaL_buffinit(L, &b);
-      for (k = 0; known[k] != NULL; k++) {
-        if (k)
-          luaL_addstring(&b, ", ");
-        luaL_addstring(&b, known[k]);
-      }
-      luaL_pushresult(&b);
-      luaL_error(L, "%s: unknown option '%s' (options: %s)", fname,
-                 lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : luaL_typename(L, -2),
-                 lua_tostring(L, -1));
-    }
-  }
-}
-
-void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o)
-{
-  lua_Integer n;
-  o->substeps = 8;
-  o->tol = 0.0;
-  if (idx == 0 || lua_isnoneornil(L, idx))
-    return;
-  if (!lua_istable(L, idx))
-    luaL_error(L, "%s: options must be a table {substeps = n, tol = t}, got %s", fname,
-               luaL_typename(L, idx));
-  n = dm_optintegerfield(L, idx, "substeps", 8);
-  if (n < 1 || n > 1000000)
-    luaL_error(L, "%s: substeps must be 1..1000000, got %d", fname, (int)n);
-  o->substeps = (size_t)n;
-  o->tol = dm_optnumberfield(L, idx, "tol", 0.0);
-  if (!(o->tol >= 0.0) || (o->tol > 0.0 && o->tol < 1e-15))
-    luaL_error(L, "%s: tol must be 0 (Magnus 4) or in [1e-15, ...) (adaptive), got %f", fname,
-               o->tol);
-}
-
-static size_t readnums(lua_State *L, int idx, const char *what, double *x, size_t n)
-{
-  gsl_vector *v = dm_tovec(L, idx);
-  size_t k;
-  if (v != NULL) {
-    if (v->size != n)
-      luaL_error(L, "%s must have %d entries, got %d", what, (int)n, (int)v->size);
-    for (k = 0; k < n; k++)
-      x[k] = gsl_vector_get(v, k);
-    return n;
-  }
-  if (n == 1 && lua_type(L, idx) == LUA_TNUMBER) {
-    x[0] = lua_tonumber(L, idx);
-    return 1;
-  }
-  if (!lua_istable(L, idx))
-    luaL_error(L, "%s must be a vec or a list of %d numbers, got %s", what, (int)n,
-               luaL_typename(L, idx));
-  if ((size_t)luaL_len(L, idx) != n)
-    luaL_error(L, "%s must have %d entries, got %d", what, (int)n, (int)luaL_len(L, idx));
-  for (k = 0; k < n; k++) {
-    lua_geti(L, idx, (lua_Integer)k + 1);
-    if (lua_type(L, -1) != LUA_TNUMBER)
-      luaL_error(L, "%s[%d] must be a number, got %s", what, (int)k + 1, luaL_typename(L, -1));
-    x[k] = lua_tonumber(L, -1);
-    lua_pop(L, 1);
-  }
-  return n;
-}
-
-void dm_lua_readshape(lua_State *L, const dm_conn_bundle *B, int idx, const char *what, double *x)
-{
-  dm_err e;
-  idx = lua_absindex(L, idx);
-  if (B->nx == 0 && lua_isnoneornil(L, idx))
-    return;
-  readnums(L, idx, what, x, B->nx);
-  if (dm_conn_shape_check(B, x, what, &e) != DM_OK)
-    luaL_error(L, "%s", e.msg);
-}
-
-double *dm_lua_readshapes(lua_State *L, const dm_conn_bundle *B, int idx, const char *what,
-                          size_t *n)
-{
-  gsl_matrix *M = dm_tomat(L, idx);
-  gsl_vector *buf;
-  char w[160];
-  size_t k, i;
-  dm_err e;
-  idx = lua_absindex(L, idx);
-  if (M != NULL) {
-    if (M->size2 != B->nx)
-      luaL_error(L, "%s: a matrix with %d columns (one point per row) expected, got %d", what,
-                 (int)B->nx, (int)M->size2);
-    *n = M->size1;
-    buf = dm_pushvec(L, *n * B->nx + 1);
-    for (k = 0; k < *n; k++)
-      for (i = 0; i < B->nx; i++)
-        buf->data[k * B->nx + i] = gsl_matrix_get(M, k, i);
-  } else {
-    if (!lua_istable(L, idx))
-      luaL_error(L, "%s: a list of shape points expected, got %s", what, luaL_typename(L, idx));
-    *n = (size_t)luaL_len(L, idx);
-    buf = dm_pushvec(L, *n * B->nx + 1);
-    for (k = 0; k < *n; k++) {
-      snprintf(w, sizeof w, "%s[%d]", what, (int)k + 1);
-      lua_geti(L, idx, (lua_Integer)k + 1);
-      readnums(L, -1, w, buf->data + k * B->nx, B->nx);
-      lua_pop(L, 1);
-    }
-  }
-  for (k = 0; k < *n; k++) {
-    snprintf(w, sizeof w, "%s[%d]", what, (int)k + 1);
-    if (dm_conn_shape_check(B, buf->data + k * B->nx, w, &e) != DM_OK)
-      luaL_error(L, "%s", e.msg);
-  }
-  return buf->data;
-}
-
-void dm_lua_readgroupelem(lua_State *L, int gidx, int idx, const char *what, double *g)
-{
-  const dm_lie_group *G = dm_lua_checkgroup(L, gidx);
-  dm_lelem *el = dm_lua_toelem(L, idx);
-  if (el != NULL) {
-    if (!dm_lie_group_equal(el->G, G))
-      luaL_error(L, "%s must be an element of %s, got an element of %s", what, G->name,
-                 el->G->name);
-    dm_lua_elem_numbers(L, el, what, g);
-    return;
-  }
-  if (lua_type(L, idx) != LUA_TNUMBER && !lua_istable(L, idx) && dm_tovec(L, idx) == NULL)
-    luaL_error(L, "%s must be an element of %s (or its %d coordinates), got %s", what, G->name,
-               (int)G->nq, luaL_typename(L, idx));
-  readnums(L, idx, what, g, G->nq);
-}
-
-void dm_lua_pushgroupelem(lua_State *L, int gidx, const double *g)
-{
-  dm_lelem *el = dm_lua_newelem(L, gidx, 0);
-  size_t i;
-  for (i = 0; i < el->G->nq; i++)
-    el->v[i].x = g[i];
-}
-
-static int holo_tostring(lua_State *L)
-{
-  luaL_Buffer b;
-  luaL_buffinit(L, &b);
-  luaL_addstring(&b, "holonomy");
-  if (lua_getfield(L, 1, "angle") == LUA_TNUMBER) {
-    char num[32];
-    dm_num_snprintf(num, sizeof num, "%.10g", lua_tonumber(L, -1));
-    luaL_addstring(&b, ": angle ");
-    luaL_addstring(&b, num);
-  }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "axis") != LUA_TNIL) {
-    luaL_addstring(&b, " about ");
-    luaL_addstring(&b, dm_tolstring(L, -1, NULL));
-    lua_pop(L, 1);
-  }
-  lua_pop(L, 1);
-  if (lua_getfield(L, 1, "body") != LUA_TNIL) {
-    luaL_addstring(&b, "; body ");
-    luaL_addstring(&b, dm_tolstring(L, -1, NULL));
-    lua_pop(L, 1);
-  }
-  lua_pop(L, 1);
-  luaL_pushresult(&b);
-  return 1;
-}
-
-void dm_lua_pushholonomy(lua_State *L, int gidx, const double *spatial, const double *body,
-                         double lifted)
-{
-  const dm_lie_group *G = dm_lua_checkgroup(L, gidx);
-  double w[DM_LIE_DIM_MAX], ang = NAN;
-  gidx = lua_absindex(L, gidx);
-  lua_createtable(L, 0, 4);
-  dm_lua_pushgroupelem(L, gidx, spatial);
-  lua_setfield(L, -2, "spatial");
-  if (body != NULL) {
-    dm_lua_pushgroupelem(L, gidx, body);
-    lua_setfield(L, -2, "body");
-  }
-  if (G->kind == DM_LIE_SO2 || G->kind == DM_LIE_SE2 || (G->kind == DM_LIE_RN && G->dim == 1)) {
-    ang = isfinite(lifted) ? lifted : (body ? body[0] : spatial[0]);
-  } else if (G->kind == DM_LIE_SO3) {
-    double n;
-    dm_lie_log(G, body ? body : spatial, w);
-    n = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    ang = n;
-    if (n > 0) {
-      w[0] /= n;
-      w[1] /= n;
-      w[2] /= n;
-      dm_pushvec_copy(L, w, 3);
-      lua_setfield(L, -2, "axis");
-    }
-  }
-  if (isfinite(ang)) {
-    lua_pushnumber(L, ang);
-    lua_setfield(L, -2, "angle");
-  }
-  if (luaL_newmetatable(L, "dmech.holonomy")) {
-    lua_pushcfunction(L, holo_tostring);
-    lua_setfield(L, -2, "__tostring");
-  }
-  lua_setmetatable(L, -2);
-}
-
-/* }==== */
 
 /* {==== bundles ============================================================= */
 
@@ -659,115 +439,14 @@ const size_t *dm_lua_phase_cols(lua_State *L, int bidx, int tidx, int q0idx, siz
 
 /* }==== */
 
-/* {==== points ============================================================== */
-
-static dm_lbpoint *topoint(lua_State *L, int idx)
-{
-  return luaL_testudata(L, idx, DM_BPOINT_MT);
-}
-
-dm_lbpoint *dm_lua_pushpoint(lua_State *L, int bidx, const double *q)
-{
-  dm_lbundle *b = dm_lua_checkbundle(L, bidx);
-  dm_lbpoint *p;
-  bidx = lua_absindex(L, bidx);
-  p = lua_newuserdatauv(L, sizeof *p + b->B->nq * sizeof(double), 1);
-  p->B = b->B;
-  memcpy(p->q, q, b->B->nq * sizeof *q);
-  luaL_setmetatable(L, DM_BPOINT_MT);
-  lua_pushvalue(L, bidx);
-  lua_setiuservalue(L, -2, 1);
-  return p;
-}
-
-/* B:point{...} contents at idx into q */
-static void point_from_table(lua_State *L, int bidx, int idx, const char *what, double *q)
-{
-  const dm_conn_bundle *B = dm_lua_checkbundle(L, bidx)->B;
-  char w[160];
-  dm_err e;
-  idx = lua_absindex(L, idx);
-  if (dm_conn_bundle_is_trivial(B)) {
-    lua_getfield(L, idx, "x");
-    lua_getfield(L, idx, "g");
-    if ((B->nx > 0 && lua_isnil(L, -2)) || lua_isnil(L, -1))
-      luaL_error(L, "%s: a point {x = {...}, g = ...} of %s expected", what, B->name);
-    snprintf(w, sizeof w, "%s.x", what);
-    dm_lua_readshape(L, B, -2, w, q);
-    snprintf(w, sizeof w, "%s.g", what);
-    dm_lua_bundle_field(L, bidx, "group");
-    dm_lua_readgroupelem(L, -1, -2, w, q + B->nx);
-    lua_pop(L, 3);
-    return;
-  }
-  if (strcmp(B->type->name, "sphere_frames") == 0) {
-    dm_lelem *el;
-    double R[9];
-    lua_getfield(L, idx, "R");
-    el = dm_lua_toelem(L, -1);
-    if (el != NULL && el->G->kind == DM_LIE_SO3) {
-      dm_lua_elem_numbers(L, el, what, R);
-    } else if (dm_tomat(L, -1) != NULL) {
-      gsl_matrix *M = dm_tomat(L, -1);
-      size_t i;
-      if (M->size1 != 3 || M->size2 != 3)
-        luaL_error(L, "%s.R: a 3x3 matrix expected", what);
-      for (i = 0; i < 9; i++)
-        R[i] = gsl_matrix_get(M, i / 3, i % 3);
-    } else {
-      luaL_error(L, "%s: a frame {R = <SO3 element>} expected, got R = %s", what,
-                 luaL_typename(L, -1));
-    }
-    {
-      dm_lie_group *G3 = dm_lie_so3(NULL);
-      int st = G3 ? dm_lie_check(G3, R, 1e-10, &e) : DM_ENOMEM;
-      dm_lie_group_free(G3);
-      if (st != DM_OK)
-        luaL_error(L, "%s.R: %s", what, e.msg);
-    }
-    memcpy(q, R, sizeof R);
-    lua_pop(L, 1);
-    return;
-  }
-  lua_getfield(L, idx, "q");
-  if (lua_isnil(L, -1))
-    luaL_error(L, "%s: a point {q = {...}} (%d coordinates) expected", what, (int)B->nq);
-  snprintf(w, sizeof w, "%s.q", what);
-  readnums(L, -1, w, q, B->nq);
-  if (dm_conn_shape_check(B, q, w, &e) != DM_OK)
-    luaL_error(L, "%s", e.msg);
-  lua_pop(L, 1);
-}
-
-void dm_lua_readpoint(lua_State *L, int bidx, int idx, const char *what, double *q)
-{
-  const dm_conn_bundle *B = dm_lua_checkbundle(L, bidx)->B;
-  dm_lbpoint *p = topoint(L, idx);
-  if (p != NULL) {
-    if (p->B != B && (p->B->nq != B->nq || p->B->type != B->type ||
-                      !dm_lie_group_equal(p->B->G, B->G)))
-      luaL_error(L, "%s: a point of %s expected, got a point of %s", what, B->name, p->B->name);
-    memcpy(q, p->q, B->nq * sizeof *q);
-    return;
-  }
-  if (lua_istable(L, idx) && luaL_len(L, idx) == 0) {
-    point_from_table(L, bidx, idx, what, q);
-    return;
-  }
-  if (lua_istable(L, idx) || dm_tovec(L, idx) != NULL) {
-    readnums(L, idx, what, q, B->nq);
-    return;
-  }
-  luaL_error(L, "%s: a point of %s (B:point{...}) expected, got %s", what, B->name,
-             luaL_typename(L, idx));
-}
+/* {==== bundle methods ====================================================== */
 
 static int b_point(lua_State *L)
 {
   dm_lbundle *b = dm_lua_checkbundle(L, 1);
   double q[DM_CONN_NQ_MAX];
   luaL_checktype(L, 2, LUA_TTABLE);
-  point_from_table(L, 1, 2, "point", q);
+  dm_lua_point_from_table(L, 1, 2, "point", q);
   dm_lua_pushpoint(L, 1, q);
   (void)b;
   return 1;
@@ -901,90 +580,6 @@ static int bundle_index(lua_State *L)
 
 /* }==== */
 
-/* {==== point class ========================================================= */
-
-static int p_coords(lua_State *L)
-{
-  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
-  dm_pushvec_copy(L, p->q, p->B->nq);
-  return 1;
-}
-
-static int p_bundle(lua_State *L)
-{
-  luaL_checkudata(L, 1, DM_BPOINT_MT);
-  lua_getiuservalue(L, 1, 1);
-  return 1;
-}
-
-static int point_index(lua_State *L)
-{
-  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
-  const char *k = lua_tostring(L, 2);
-  const dm_conn_bundle *B = p->B;
-  if (k != NULL) {
-    int triv = dm_conn_bundle_is_trivial(B), sph = strcmp(B->type->name, "sphere_frames") == 0;
-    if (strcmp(k, "x") == 0 || (sph && strcmp(k, "p") == 0)) {
-      double x[DM_CONN_NX_MAX];
-      dm_conn_proj(B, p->q, x);
-      dm_pushvec_copy(L, x, B->nx);
-      return 1;
-    }
-    if (strcmp(k, "g") == 0 && triv) {
-      lua_getiuservalue(L, 1, 1);
-      dm_lua_bundle_field(L, -1, "group");
-      dm_lua_pushgroupelem(L, -1, p->q + B->nx);
-      return 1;
-    }
-    if (strcmp(k, "R") == 0 && sph) {
-      dm_lie_group **slot = dm_lua_newgroup(L);
-      dm_err e;
-      if ((*slot = dm_lie_so3(&e)) == NULL)
-        return dm_lua_fail(L, "point.R", e.status, &e);
-      dm_lua_pushgroupelem(L, -1, p->q);
-      return 1;
-    }
-    if (strcmp(k, "q") == 0)
-      return p_coords(L);
-  }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
-}
-
-static int point_tostring(lua_State *L)
-{
-  dm_lbpoint *p = luaL_checkudata(L, 1, DM_BPOINT_MT);
-  const dm_conn_bundle *B = p->B;
-  char buf[640], v[200], g[160];
-  if (dm_conn_bundle_is_trivial(B)) {
-    dm_num_format_vec(v, sizeof v, p->q, B->nx);
-    dm_lie_describe(B->G, p->q + B->nx, g, sizeof g);
-    snprintf(buf, sizeof buf, "<point of %s: x = %s, g = %s>", B->name, v, g);
-  } else if (strcmp(B->type->name, "sphere_frames") == 0) {
-    double x[3];
-    dm_conn_proj(B, p->q, x);
-    dm_num_format_vec(v, sizeof v, x, 3);
-    dm_num_format_vec(g, sizeof g, p->q, 9);
-    snprintf(buf, sizeof buf, "<frame over p = %s: R = %s>", v, g);
-  } else {
-    dm_num_format_vec(v, sizeof v, p->q, B->nq);
-    snprintf(buf, sizeof buf, "<point of %s: q = %s>", B->name, v);
-  }
-  lua_pushstring(L, buf);
-  return 1;
-}
-
-static const dm_reg point_methods[] = {
-  {"coords", p_coords, "q:coords() -> vec", "The stored coordinates of the point (shape chart, then group)."},
-  {"bundle", p_bundle, "q:bundle() -> B", "The bundle of the point."},
-  {NULL, NULL, NULL, NULL}
-};
-
-/* }==== */
-
 static const dm_reg conn_funcs[] = {
   {"bundle", l_bundle,
    "dm.bundle{shape_dim = m, group = G[, L = l, params = {...}]} | {name = \"platform\", ...} | {system = sys, acts_on = {...}} -> B",
@@ -1000,12 +595,9 @@ void dm_open_conn(lua_State *L)
   static const luaL_Reg bmeta[] = {{"__index", bundle_index}, {"__gc", bundle_gc},
                                    {"__close", bundle_gc}, {"__tostring", b_tostring},
                                    {NULL, NULL}};
-  static const luaL_Reg pmeta[] = {{"__index", point_index}, {"__tostring", point_tostring},
-                                   {NULL, NULL}};
   dm_newclass(L, DM_BUNDLE_MT, "B", bundle_methods, bmeta);
   lua_pop(L, 1);
-  dm_newclass(L, DM_BPOINT_MT, "q", point_methods, pmeta);
-  lua_pop(L, 1);
+  dm_lua_open_conn_point(L);
   lua_pushvalue(L, dm);
   dm_register(L, "dm.", conn_funcs);
   lua_pop(L, 1);

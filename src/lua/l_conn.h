@@ -1,5 +1,6 @@
 /* l_conn.h -- private glue of the connection bindings: l_conn.c (dm.bundle,
- * bundles and their points), l_conn_cont.c (dm.connection,
+ * bundles), l_conn_point.c (their points), l_conn_args.c (readers of
+ * shapes, group elements, options), l_conn_cont.c (dm.connection,
  * dm.mechanical_connection), l_conn_disc.c (dm.discrete_connection,
  * dm.discrete_mechanical_connection, dm.order_test), l_conn_mesh.c (the
  * Levi-Civita connection of a triangle mesh).
@@ -34,15 +35,47 @@ typedef struct dm_lbpoint {
   double q[];
 } dm_lbpoint;
 
-/* bundles and points (l_conn.c) */
+/* bundles (l_conn.c) */
 dm_lbundle *dm_lua_checkbundle(lua_State *L, int idx);
 /* Push the field `key` of the bundle's user value table. */
 void dm_lua_bundle_field(lua_State *L, int bidx, const char *key);
+/* The reduced Lagrangian of the bundle at bidx traced into nodes: pushes
+ * nothing, fills xs, xd (nx), xi (dim), par (npar) and *l; 0 when the
+ * bundle has no Lagrangian.  npar <= 32. */
+int dm_lua_bundle_lagrangian(lua_State *L, int bidx, dm_expr *xs, dm_expr *xd, dm_expr *xi,
+                             dm_expr *par, double *parval, size_t *npar, dm_expr *l);
+/* Trace l(x, xdot, xi, p) (the function at fidx, parameters {{name,
+ * value}, ...} at pidx) for the bundle B: fills the nodes as above. */
+void dm_lua_trace_lagrangian(lua_State *L, const dm_conn_bundle *B, int fidx, int pidx,
+                             dm_expr *xs, dm_expr *xd, dm_expr *xi, dm_expr *par, double *parval,
+                             size_t *npar, dm_expr *l);
+/* The columns of a trajectory (at tidx) that sample the shape of the
+ * bundle at bidx: NULL when its coordinates are the shape coordinates,
+ * else the columns of the shape coordinates by name (bundles from a
+ * system) written into buf (nx); raises otherwise.  Then reads q0 from
+ * q0idx (0 or nil: the first sample with the identity) into q0. */
+const size_t *dm_lua_phase_cols(lua_State *L, int bidx, int tidx, int q0idx, size_t *buf,
+                                double *q0);
+
+/* points (l_conn_point.c) */
 /* A new point of the bundle at bidx holding q (nq numbers). */
 dm_lbpoint *dm_lua_pushpoint(lua_State *L, int bidx, const double *q);
 /* Read a point of the bundle at bidx from idx: a point of that bundle, or
  * a table as B:point{...} takes, or nq coordinates.  Raises naming what. */
 void dm_lua_readpoint(lua_State *L, int bidx, int idx, const char *what, double *q);
+/* The contents of B:point{...} (the table at idx) into q: {x =, g =} on
+ * trivial bundles, {R =} on the sphere frames, {q =} otherwise. */
+void dm_lua_point_from_table(lua_State *L, int bidx, int idx, const char *what, double *q);
+/* The point class "dmech.bpoint" (called by dm_open_conn). */
+void dm_lua_open_conn_point(lua_State *L);
+
+/* readers shared by the connection bindings (l_conn_args.c) */
+/* n numbers at idx: a vec, a list, or (n = 1) a number; raises naming what. */
+size_t dm_lua_conn_readnums(lua_State *L, int idx, const char *what, double *x, size_t n);
+/* Options of a transport: {substeps = n, tol = t} at idx (0: none). */
+void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o);
+/* Raise "<fname>: unknown option 'k' (options: a, b)" for keys not in known. */
+void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known);
 /* A shape point (nx numbers: a vec or a list), checked by the bundle. */
 void dm_lua_readshape(lua_State *L, const dm_conn_bundle *B, int idx, const char *what,
                       double *x);
@@ -60,36 +93,14 @@ void dm_lua_pushgroupelem(lua_State *L, int gidx, const double *g);
  * __tostring; gidx the group userdata; body may be NULL. */
 void dm_lua_pushholonomy(lua_State *L, int gidx, const double *spatial, const double *body,
                          double lifted);
-/* The reduced Lagrangian of the bundle at bidx traced into nodes: pushes
- * nothing, fills xs, xd (nx), xi (dim), par (npar) and *l; 0 when the
- * bundle has no Lagrangian.  npar <= 32. */
-int dm_lua_bundle_lagrangian(lua_State *L, int bidx, dm_expr *xs, dm_expr *xd, dm_expr *xi,
-                             dm_expr *par, double *parval, size_t *npar, dm_expr *l);
-/* Trace l(x, xdot, xi, p) (the function at fidx, parameters {{name,
- * value}, ...} at pidx) for the bundle B: fills the nodes as above. */
-void dm_lua_trace_lagrangian(lua_State *L, const dm_conn_bundle *B, int fidx, int pidx,
-                             dm_expr *xs, dm_expr *xd, dm_expr *xi, dm_expr *par, double *parval,
-                             size_t *npar, dm_expr *l);
-/* Options of a transport: {substeps = n, tol = t} at idx (0: none). */
-void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o);
-/* Raise "<fname>: unknown option 'k' (options: a, b)" for keys not in known. */
-void dm_lua_conn_checkkeys(lua_State *L, int idx, const char *fname, const char *const *known);
 
-/* The columns of a trajectory (at tidx) that sample the shape of the
- * bundle at bidx: NULL when its coordinates are the shape coordinates,
- * else the columns of the shape coordinates by name (bundles from a
- * system) written into buf (nx); raises otherwise.  Then reads q0 from
- * q0idx (0 or nil: the first sample with the identity) into q0. */
-const size_t *dm_lua_phase_cols(lua_State *L, int bidx, int tidx, int q0idx, size_t *buf,
-                                double *q0);
+/* continuous connections (l_conn_cont.c) */
 /* Push a connection on a new trivial bundle S x G (G the group userdata
  * at gidx) from the expressions A (dim x nx) in the symbols x, with
  * parameters par (names pnames, values pv): red:connection(). */
 void dm_lua_push_conn_exprs(lua_State *L, int gidx, const char *name, size_t nx,
                             const dm_expr *x, const dm_expr *A, size_t npar, const dm_expr *par,
                             const char *const *pnames, const double *pv);
-
-/* continuous connections (l_conn_cont.c) */
 dm_conn *dm_lua_checkconn(lua_State *L, int idx);
 dm_conn *dm_lua_toconn(lua_State *L, int idx);
 void dm_lua_open_conn_cont(lua_State *L);
