@@ -61,8 +61,9 @@ size_t dm_lua_toexprs(lua_State *L, int idx, const char *what, dm_expr *out,
 /* dm.config.native as an enum dm_native_mode (raises on a bad value). */
 int dm_lua_native_mode(lua_State *L);
 
-/* ---- shared by l_expr.c, l_expr_calc.c, l_expr_fn.c only ---- */
+/* ---- shared by l_expr.c, l_expr_calc.c, l_expr_fn.c, l_expr_sym.c only ---- */
 void dm_open_expr_fn(lua_State *L);                   /* dm.fn */
+void dm_open_expr_sym(lua_State *L);                  /* dm.sym, dm.symvec, dm.trace */
 int dm_lua_ctx_raise(lua_State *L, dm_expr_ctx *ctx);  /* raise + clear */
 dm_expr dm_lua_checkexpr_only(lua_State *L, int idx);  /* no numbers */
 extern const dm_reg dm_lexpr_methods[];               /* expr:... */
