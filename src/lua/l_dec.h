@@ -1,5 +1,5 @@
-/* l_dec.h -- shared by the DEC bindings (l_dec.c meshes, l_dec_sparse.c
- * sparse matrices, l_dec_cochain.c cochains).
+/* l_dec.h -- shared by the DEC bindings (l_dec.c meshes, l_dec_mesh.c their
+ * constructors, l_dec_sparse.c sparse matrices, l_dec_cochain.c cochains).
  *
  * A Mesh owns its complex and geometry.  Cochains and operators built from a
  * mesh keep it alive through user value 1 and remember its complex, so that
@@ -60,6 +60,13 @@ int dm_dec_typesize(const dm_dec_complex *K, dm_ltype t);
 
 /* Push a new Mesh owning K and G (NULL: raise e's message). */
 dm_lmesh *dm_pushmesh(lua_State *L, dm_dec_complex *K, dm_dec_geom *G, const char *what, dm_err *e);
+/* Push a Mesh built from m (consumed; NULL: raise e's message). */
+dm_lmesh *dm_pushmesh_data(lua_State *L, dm_dec_meshdata *m, const char *what, dm_err *e);
+/* Unknown option keys of the table at t raise "<fname>: unknown option 'k'
+ * (options: a, b)" (a misspelt option is never silently ignored). */
+void dm_dec_checkopts(lua_State *L, int t, const char *fname, const char *const *known);
+/* dm.mesh with its constructors (l_dec_mesh.c) into the table at the top. */
+void dm_open_dec_mesh(lua_State *L);
 /* The methods of l_dec_ops.c into the Mesh class, dm.mesh.load. */
 void dm_open_dec_ops(lua_State *L);
 
