@@ -390,6 +390,68 @@ static void emit_chunk(em *E, sbuf *b, size_t c)
   sb_printf(b, "}\n");
 }
 
+/* The stores of inputs, parameters and constants to outputs (the first
+ * nplain of E->st) as three loops over static tables. */
+static void emit_plain_tables(em *E, sbuf *b, const uint32_t *oreg, size_t nplain)
+{
+  static const char *const what[3] = {"input", "parameter", "constant"};
+  char x[64];
+  for (int kind = 0; kind < 3; kind++) {
+    size_t n = 0;
+    for (size_t s = 0; s < nplain; s++) {
+      uint32_t r = oreg[E->st[s].k];
+      n += (r < E->nin ? 0 : r < E->nin + E->npar ? 1 : 2) == kind;
+    }
+    if (n == 0)
+      continue;
+    sb_printf(b, "  { /* %zu outputs that are a%s %s */\n", n, kind == 0 ? "n" : "", what[kind]);
+    sb_printf(b, "    static const unsigned char da[%zu] = {", n);
+    size_t j = 0;
+    for (size_t s = 0; s < nplain; s++) {
+      uint32_t r = oreg[E->st[s].k];
+      if ((r < E->nin ? 0 : r < E->nin + E->npar ? 1 : 2) == kind)
+        sb_printf(b, "%s%u", j++ == 0 ? "" : j % 32 == 1 ? ",\n      " : ",", E->st[s].arr);
+    }
+    sb_printf(b, "};\n    static const unsigned de[%zu] = {", n);
+    j = 0;
+    for (size_t s = 0; s < nplain; s++) {
+      uint32_t r = oreg[E->st[s].k];
+      if ((r < E->nin ? 0 : r < E->nin + E->npar ? 1 : 2) == kind)
+        sb_printf(b, "%s%u", j++ == 0 ? "" : j % 16 == 1 ? ",\n      " : ",", E->st[s].elem);
+    }
+    sb_printf(b, "};\n");
+    if (kind == 0 && E->inmap != NULL)
+      sb_printf(b, "    static const unsigned char sa[%zu] = {", n);
+    else
+      sb_printf(b, kind == 2 ? "    static const double sv[%zu] = {"
+                             : "    static const unsigned se[%zu] = {", n);
+    j = 0;
+    for (int pass = 0; pass < (kind == 0 && E->inmap != NULL ? 2 : 1); pass++) {
+      if (pass == 1)
+        sb_printf(b, "};\n    static const unsigned se[%zu] = {", n), j = 0;
+      for (size_t s = 0; s < nplain; s++) {
+        uint32_t r = oreg[E->st[s].k];
+        if ((r < E->nin ? 0 : r < E->nin + E->npar ? 1 : 2) != kind)
+          continue;
+        const char *sep = j++ == 0 ? "" : j % 8 == 1 ? ",\n      " : ",";
+        if (kind == 2) {
+          operand(E, b, x, sizeof x, NOVAL, 0, r, 0);
+          sb_printf(b, "%s%s", sep, x);
+        } else if (kind == 1) {
+          sb_printf(b, "%s%u", sep, r - E->nin);
+        } else if (E->inmap == NULL) {
+          sb_printf(b, "%s%u", sep, r);
+        } else {
+          sb_printf(b, "%s%u", sep, pass == 0 ? E->inmap[r].arr : E->inmap[r].elem);
+        }
+      }
+    }
+    sb_printf(b, "};\n    for (size_t j = 0; j < %zu; j++)\n      out[da[j]][de[j]] = %s;\n  }\n",
+              n, kind == 2 ? "sv[j]" : kind == 1 ? "par[se[j]]"
+                 : E->inmap != NULL ? "in[sa[j]][se[j]]" : "in[0][se[j]]");
+  }
+}
+
 /* The value an output register holds at the end (NOVAL: input, parameter
  * or constant). */
 static size_t final_value(const em *E, uint32_t r)
@@ -437,10 +499,19 @@ static void emit_entry(em *E, sbuf *b, const dm_native_map *outmap, size_t nmap)
       sb_printf(b, "  o[%u] = (mask & %uu) ? out_[%u] : work + %u;\n", a, 1u << a, a, off[a]);
     sb_printf(b, "  (void)%uu;\n  double *const *out = o;\n", full);
   }
-  /* outputs that are no instruction's result */
-  for (size_t s = 0; s < E->nst && E->st[s].val == NOVAL; s++) {
-    operand(E, b, x, sizeof x, NOVAL, 0, oreg[E->st[s].k], 0);
-    sb_printf(b, "  out[%u][%u] = %s;\n", E->st[s].arr, E->st[s].elem, x);
+  /* outputs that are no instruction's result: one store each, or (many:
+   * the zeros of a dense Hessian) loops over tables, which the compiler
+   * reads in no time where thousands of stores took it a second */
+  size_t nplain = 0;
+  while (nplain < E->nst && E->st[nplain].val == NOVAL)
+    nplain++;
+  if (nplain <= 32) {
+    for (size_t s = 0; s < nplain; s++) {
+      operand(E, b, x, sizeof x, NOVAL, 0, oreg[E->st[s].k], 0);
+      sb_printf(b, "  out[%u][%u] = %s;\n", E->st[s].arr, E->st[s].elem, x);
+    }
+  } else {
+    emit_plain_tables(E, b, oreg, nplain);
   }
   for (size_t c = 0; c < E->nchunk; c++)
     sb_printf(b, "  dm_k%zu(in, par, r, out);\n", c);
