@@ -25,6 +25,7 @@ struct dm_native {
   const dm_native_map *inmap, *outmap;  /* during compilation only */
   size_t nmap;
   int cached;
+  int fd;                 /* open while dl was loaded through /proc/self/fd/<fd>, else -1 */
   char key[65];
 };
 
@@ -34,6 +35,8 @@ void dm_native_free(dm_native *nat)
     return;
   if (nat->dl != NULL)
     dlclose(nat->dl);
+  if (nat->fd >= 0)
+    close(nat->fd);
   free(nat);
 }
 
@@ -293,13 +296,19 @@ static int compile_native(const dm_tape *t, const double *in0,
      * was stored: a damaged object is never executed */
     char lpath[4200];
     int cfd = dm_native__cache_open(cached, lpath, sizeof lpath);
+    /* the descriptor stays open while the object is loaded: the dynamic
+     * loader knows an object by the name it was opened with, and a second
+     * object opened as /proc/self/fd/<the same number> would be taken for
+     * the first one */
     if (cfd >= 0 && load(lpath, nat->key, nat, NULL) == DM_OK) {
-      close(cfd);
+      nat->fd = cfd;
       if (verify(t, nat, in0, par0, NULL) == DM_OK) {
         nat->cached = 1;
         return DM_OK;
       }
       dlclose(nat->dl);                /* stale or damaged: rebuild */
+      close(nat->fd);
+      nat->fd = -1;
       nat->dl = NULL;
       nat->fn = NULL;
       nat->scatter = NULL;
@@ -369,6 +378,7 @@ int dm_native__compile_with(const dm_tape *t, const double *in0,
     free(nat);
     return dm_err_set(err, DM_ENOMEM, "native: out of memory");
   }
+  nat->fd = -1;
   nat->inmap = inmap;
   nat->outmap = outmap;
   nat->nmap = nmap;

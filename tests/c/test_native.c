@@ -234,6 +234,34 @@ static void test_cache(void)
   tap_ok(st == DM_OK && !dm_native_cached(again), "a damaged cached object "
          "is replaced (%s)", st == DM_OK ? "ok" : err.msg);
   dm_native_free(again);
+  /* two cached objects loaded at once, each for the first time in this
+   * process: both hits, each its own code (the dynamic loader must not
+   * take the second for the first) */
+  dm_expr e2[1] = { tx_parse(C, "cos(x)*y + z*k") };
+  dm_tape *t2;
+  dm_native *o1 = NULL, *o2 = NULL;
+  dm_tape_compile(C, 1, e2, 3, V, 2, V + 3, &t2, NULL);
+  st = dm_native_compile(t, base, base + 3, &o1, &err);     /* both stored */
+  int sb = dm_native_compile(t2, base, base + 3, &o2, &err);
+  dm_native_free(o1);
+  dm_native_free(o2);
+  o1 = o2 = NULL;
+  if (st == DM_OK && sb == DM_OK) {
+    st = dm_native_compile(t, base, base + 3, &o1, &err);
+    sb = dm_native_compile(t2, base, base + 3, &o2, &err);
+  }
+  double x3[3] = {0.3, -1.2, 2.0}, p2[2] = {0.7, 1.5}, out2[1] = {0}, want2[1] = {0};
+  double *w2 = malloc((dm_tape_work_size(t2) + 1) * sizeof *w2);
+  dm_tape_eval(t2, x3, p2, want2, w2);
+  if (st == DM_OK && sb == DM_OK)
+    dm_native_function(o2)(x3, p2, out2);
+  tap_ok(st == DM_OK && sb == DM_OK && dm_native_cached(o1) && dm_native_cached(o2) &&
+         out2[0] == want2[0], "two cached objects loaded at once: both cache hits, "
+         "each computing its own tape");
+  free(w2);
+  dm_native_free(o1);
+  dm_native_free(o2);
+  dm_tape_free(t2);
   dm_tape_free(t);
 }
 
