@@ -15,8 +15,10 @@
 
 #include <string.h>
 
-static const char *const gauss_options[] = {"stages", "h", "tol", "maxiter", "simplified", "linear", NULL};
-static const char *const midpoint_options[] = {"h", "tol", "maxiter", "simplified", "linear", NULL};
+static const char *const gauss_options[] = {"stages", "h", "tol", "maxiter", "simplified",
+                                            "linear", "iteration", NULL};
+static const char *const midpoint_options[] = {"h", "tol", "maxiter", "simplified", "linear",
+                                               "iteration", NULL};
 
 static int make(dm_integrator *I, size_t s, dm_err *e)
 {

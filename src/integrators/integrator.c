@@ -40,6 +40,9 @@ const dm_option_desc dm_integ_options[] = {
   {"phases", DM_OPT_INT, OPT(phases), 4, 64, "multiscale: phases of the oscillation sampled (default 8)"},
   {"linear", DM_OPT_STRING, OPT(linear), 0, 0,
    "Newton matrices: dense LU, sparse LU (KLU) or auto (default: sparse for large sparse systems)"},
+  {"iteration", DM_OPT_STRING, OPT(iteration), 0, 0,
+   "stage equations: newton, fixed (fixed-point iteration on a separable L, Newton when it "
+   "contracts slowly) or auto (default: fixed above 32 coordinates)"},
   {NULL, 0, 0, 0, 0, 0, NULL}
 };
 #undef OPT
@@ -59,6 +62,7 @@ void dm_integ_opts_init(dm_integ_opts *o)
   o->power = 1.0;
   o->nodes = 4;
   o->phases = 8;
+  strcpy(o->iteration, "auto");
 }
 
 const dm_option_desc *dm_integ_option_find(const char *name)

@@ -89,7 +89,14 @@ typedef struct dm_integ_opts {
   char fast[DM_INTEG_STRMAX];    /* multiscale: fast coordinates, comma-separated */
   int nodes;           /* multiscale: Lobatto nodes of the Filon rule (4) */
   int phases;          /* multiscale: phases sampled per step (8) */
+  char iteration[DM_INTEG_STRMAX];  /* stage equations: auto (default), newton, fixed */
 } dm_integ_opts;
+
+/* How the stage equations of an implicit method are solved (option
+ * "iteration"): Newton, or first the fixed-point iteration
+ * V_i <- M^{-1} (p0 + h sum_j at_ij W_j) of a separable system (Newton
+ * takes over when it contracts slowly), or chosen by size. */
+enum dm_iteration_mode { DM_ITER_AUTO = 0, DM_ITER_NEWTON, DM_ITER_FIXED };
 
 enum dm_opt_kind { DM_OPT_INT, DM_OPT_DOUBLE, DM_OPT_BOOL, DM_OPT_STRING };
 
@@ -196,6 +203,7 @@ typedef struct dm_integ_stats {
   size_t nnz;           /* entries of a sparse Newton matrix */
   long flagged;         /* steps a family flagged since new() or reset (sem:
                          * "energy not matched", sem.h) */
+  long fixed_total;     /* steps solved by the fixed-point iteration alone */
 } dm_integ_stats;
 
 struct dm_integrator {

@@ -7,8 +7,10 @@
 #include <config.h>
 #include "integrators/integ_impl.h"
 
-static const char *const lobatto_options[] = {"stages", "h", "tol", "maxiter", "simplified", "explicit", "linear", NULL};
-static const char *const trapezoid_options[] = {"h", "tol", "maxiter", "simplified", "explicit", "linear", NULL};
+static const char *const lobatto_options[] = {"stages", "h", "tol", "maxiter", "simplified",
+                                              "explicit", "linear", "iteration", NULL};
+static const char *const trapezoid_options[] = {"h", "tol", "maxiter", "simplified", "explicit",
+                                                "linear", "iteration", NULL};
 
 static int make(dm_integrator *I, size_t s, dm_err *e)
 {

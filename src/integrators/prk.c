@@ -5,7 +5,7 @@
 #include <config.h>
 #include "integrators/integ_impl.h"
 
-static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", "simplified", "linear",
+static const char *const prk_options[] = {"tableau", "h", "tol", "maxiter", "simplified", "linear", "iteration",
                                           NULL};
 
 static int prk_alloc(dm_integrator *I, dm_err *e)

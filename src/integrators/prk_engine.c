@@ -15,6 +15,14 @@
  * rule of src/core/newton.h (scaled update <= tol, default 10 eps, or a
  * round-off stall below DM_NEWTON_ACCEPT = 1e-10); at most maxiter
  * iterations (failure: DM_ENOCONV with the update, residual and tolerance).
+ * A separable, unforced, unconstrained system L = 1/2 v^T M v - V(q) may
+ * first iterate without any matrix (option iteration; by default above
+ * DM_PRK_FIXED_MIN coordinates, where the linear solves dominate):
+ *   V_i <- V_i - M^{-1} R_i = M^{-1} (p0 + h sum_j at_ij W_j),
+ * with the same stopping rule; when the updates contract less than
+ * DM_PRK_FIXED_RATE per iteration Newton takes over from the iterate
+ * reached (and is used alone for the next DM_PRK_FIXED_BACKOFF steps).
+ * Both converge to the same stages, so they agree to round-off.
  * The predictor extrapolates the previous step's stage-velocity polynomial
  * (nodes c, values V) to the new stage times; without history (or with
  * repeated nodes) it starts from the previous stages or from v(q0, p0).
@@ -54,6 +62,17 @@ static size_t nunk(const dm_prk *P, int mode)
  * See doc/scale.md for the measurements behind the numbers. */
 #define DM_PRK_SPARSE_MIN 48
 #define DM_PRK_DENSE_MAX 2048
+/* The fixed-point iteration (see the top): used by default above this
+ * many coordinates; abandoned for Newton when an update is more than
+ * DM_PRK_FIXED_RATE times the one before (or after DM_PRK_FIXED_MAXITER
+ * iterations), then not tried for DM_PRK_FIXED_BACKOFF steps.  One
+ * iteration costs the stage forces only, a Newton iteration also a
+ * linear solve with the s n x s n matrix (and its factorisation): see
+ * doc/scale.md for the measurements. */
+#define DM_PRK_FIXED_MIN 32
+#define DM_PRK_FIXED_RATE 0.25
+#define DM_PRK_FIXED_MAXITER 30
+#define DM_PRK_FIXED_BACKOFF 64
 
 static int want_sparse(const dm_system *sys, size_t s, size_t N, int linear)
 {
@@ -187,6 +206,7 @@ void dm_prk_free(dm_prk *P)
 void dm_prk_reset(dm_prk *P)
 {
   P->hist = 0;
+  P->fixed_backoff = 0;
   P->svf_valid = 0;
   P->E_ratio = NAN;
   memset(P->cq, 0, P->n * sizeof(double));
@@ -393,13 +413,174 @@ int dm_prk_singular(dm_prk *P, const char *what, double h, dm_err *e)
                          : "; try a smaller step");
 }
 
+/* One fixed-point iteration at X: the stage points Q, the forces W = Lq
+ * there (the only derivative it needs: Lv = M V is the mass's), and
+ *   X_i <- M^{-1} (p0 + h sum_j at_ij W_j);
+ * returns the scaled update (update_norm's, NaN when something is not
+ * finite) or an evaluation error in *st. */
+static double fixed_iterate(dm_prk *P, double h, const double *q0, const double *p0,
+                            double p0norm, int *st, dm_err *e)
+{
+  const size_t n = P->n, s = P->s;
+  const double *restrict A = P->tab->a, *restrict At = P->tab->at;
+  const double *restrict Md = P->Mdiag;
+  double *restrict X = P->X, *restrict Q = P->Q, *restrict W = P->W;
+  double *restrict t = P->tmp, rv = 0.0, xv = 0.0, nan = 0.0;
+  /* the sums over j in the order of assemble's (bitwise the same), as
+   * loops over a that vectorise */
+  for (size_t i = 0; i < s; i++) {
+    double *restrict Qi = Q + i * n;
+    memset(t, 0, n * sizeof *t);
+    for (size_t j = 0; j < s; j++) {
+      const double c = A[i * s + j], *restrict Xj = X + j * n;
+      for (size_t a = 0; a < n; a++)
+        t[a] += c * Xj[a];
+    }
+    for (size_t a = 0; a < n; a++)
+      Qi[a] = q0[a] + h * t[a];
+  }
+  for (size_t i = 0; i < s; i++) {
+    dm_lag_out o = {0, W + i * n, P->Lv + i * n, NULL, NULL, NULL};
+    if ((*st = dm_eval_lag(P->sys, Q + i * n, X + i * n, DM_LAG_Q, &o, P->work, e)) != DM_OK)
+      return NAN;
+  }
+  double wn = 0.0;
+  for (size_t a = 0; a < s * n; a++) {
+    double w = fabs(W[a]);
+    wn = w > wn ? w : wn;
+  }
+  for (size_t i = 0; i < s; i++) {
+    double *restrict Xi = X + i * n;
+    t = P->tmp;
+    memset(t, 0, n * sizeof *t);
+    for (size_t j = 0; j < s; j++) {
+      const double c = At[i * s + j], *restrict Wj = W + j * n;
+      for (size_t a = 0; a < n; a++)
+        t[a] += c * Wj[a];
+    }
+    for (size_t a = 0; a < n; a++)
+      t[a] = p0[a] + h * t[a];
+    if (P->mass_kind == DM_MASS_FULL) {
+      const double *Mi = P->Minv;
+      for (size_t a = 0; a < n; a++) {
+        double u = 0.0;
+        for (size_t c = 0; c < n; c++)
+          u += Mi[a * n + c] * t[c];
+        P->v1w[a] = u;
+      }
+      t = P->v1w;
+    } else if (P->mass_kind == DM_MASS_DIAG) {
+      for (size_t a = 0; a < n; a++)
+        t[a] *= Md[a];
+    }
+    for (size_t a = 0; a < n; a++) {
+      double r = fabs(Xi[a] - t[a]), x = fabs(t[a]);
+      Xi[a] = t[a];
+      rv = r > rv ? r : rv;
+      xv = x > xv ? x : xv;
+      nan += r * 0.0;                   /* NaN iff r is (x NaN makes r NaN) */
+    }
+  }
+  *st = DM_OK;
+  if (nan != 0.0 || nan != nan)
+    return NAN;
+  /* update_norm's scaling (velocities against max(|V|, momentum scale /
+   * |M|)), |p0| computed once per step */
+  double ms = p0norm + fabs(h) * wn, lv = P->mass_norm;
+  return rv / dm_max3(xv, lv > 0 ? ms / lv : 0.0, DBL_MIN);
+}
+
+/* The fixed-point iteration from the predicted stages: DM_OK with *done
+ * set when it converged (stages, W and stats as newton leaves them), DM_OK
+ * with *done clear when Newton should take over (from the predictor again
+ * when an iterate went bad), or an error that Newton could not avoid
+ * either (out of memory, interrupted). */
+static int fixed_point(dm_prk *P, int mode, double h, const double *q0, const double *p0,
+                       int *its, int *done, double *dout, dm_err *e)
+{
+  const size_t sn = P->sn;
+  double d = HUGE_VAL, dlast = HUGE_VAL;
+  double *saved = P->rhs;              /* the predictor (rhs: scratch between steps) */
+  dm_newton_test stop = DM_NEWTON_TEST_INIT;
+  int it, st = DM_OK;
+  const double p0norm = dm_norm_inf(p0, P->n);
+  *done = 0;
+  *its = 0;
+  memcpy(saved, P->X, sn * sizeof(double));
+  P->lvv_norm = P->mass_norm;
+  for (it = 1; it <= DM_PRK_FIXED_MAXITER; it++) {
+    dm_err le;
+    d = fixed_iterate(P, h, q0, p0, p0norm, &st, &le);
+    if (st == DM_ENOMEM || st == DM_EINTR) {
+      if (e != NULL)
+        *e = le;
+      return st;
+    }
+    *its = it;
+    if (st != DM_OK || !isfinite(d))
+      break;                            /* a bad iterate: Newton from the predictor */
+    /* done at the tolerance, or when the contraction seen so far puts the
+     * distance left, rate d / (1 - rate), below it (a linearly converging
+     * iteration: the next update would only confirm) */
+    double rate = it >= 2 ? d / dlast : 1.0;
+    if (dm_newton_done(&stop, d, P->tol) || (rate < 0.5 && d * rate / (1.0 - rate) <= P->tol)) {
+      *done = 1;
+      break;
+    }
+    if (it >= 2 && d > DM_PRK_FIXED_RATE * dlast) {
+      P->fixed_backoff = P->iteration == DM_ITER_AUTO ? DM_PRK_FIXED_BACKOFF : 0;
+      return DM_OK;                     /* slow: Newton goes on from here */
+    }
+    dlast = d;
+  }
+  if (!*done) {
+    memcpy(P->X, saved, sn * sizeof(double));
+    P->fixed_backoff = P->iteration == DM_ITER_AUTO ? DM_PRK_FIXED_BACKOFF : 0;
+    return DM_OK;
+  }
+  *dout = d;
+  /* the forces were evaluated before the last update, as in newton */
+  if (d <= 1e-12)
+    return DM_OK;
+  return assemble(P, mode, h, q0, p0, 0, e);   /* W at the final stages */
+}
+
+static int use_fixed(dm_prk *P, int mode)
+{
+  if (mode != DM_PRK_STEP || !P->fixed_ok || P->iteration == DM_ITER_NEWTON)
+    return 0;
+  if (P->fixed_backoff > 0) {
+    P->fixed_backoff--;
+    return 0;
+  }
+  return 1;
+}
+
 static int newton(dm_prk *P, int mode, double h, const double *q0, const double *p0,
                   dm_integ_stats *stt, dm_err *e)
 {
   size_t N = nunk(P, mode), i;
   double d = HUGE_VAL, dlast = HUGE_VAL, rn = HUGE_VAL;
   dm_newton_test stop = DM_NEWTON_TEST_INIT;
-  int it, st, ok = 0, jac = 1, njac = 0;
+  int it, st, ok = 0, jac = 1, njac = 0, fits = 0;
+  if (use_fixed(P, mode)) {
+    int done;
+    double fd = 0.0;
+    if ((st = fixed_point(P, mode, h, q0, p0, &fits, &done, &fd, e)) != DM_OK)
+      return st;
+    if (done) {
+      if (stt) {
+        stt->iters = fits;
+        stt->jacs = 0;
+        stt->residual = fd;
+        stt->tol = P->tol;
+        stt->iters_total += fits;
+        stt->fixed_total++;
+      }
+      P->njac = 0;
+      return DM_OK;
+    }
+  }
   for (it = 1; it <= P->maxiter; it++) {
     if ((st = assemble(P, mode, h, q0, p0, jac, e)) != DM_OK)
       return st;
@@ -455,11 +636,11 @@ static int newton(dm_prk *P, int mode, double h, const double *q0, const double 
   if (it > P->maxiter)
     it = P->maxiter;
   if (stt) {
-    stt->iters = it;
+    stt->iters = it + fits;
     stt->jacs = njac;
     stt->residual = d;
     stt->tol = P->tol;
-    stt->iters_total += it;
+    stt->iters_total += it + fits;
   }
   P->njac = njac;
   if (!ok)
@@ -669,6 +850,38 @@ int dm_prk_dlegendre(dm_prk *P, double h, const double *q0, const double *q1,
 
 /* {==== type-object glue for the PRK families ============================ */
 
+/* The iteration option: whether the fixed-point iteration applies (auto:
+ * quietly not when the system does not allow it; fixed: an error then). */
+static int fixed_setup(dm_prk *P, const char *name, dm_err *e)
+{
+  if (name == NULL || name[0] == '\0' || strcmp(name, "auto") == 0)
+    P->iteration = DM_ITER_AUTO;
+  else if (strcmp(name, "newton") == 0)
+    P->iteration = DM_ITER_NEWTON;
+  else if (strcmp(name, "fixed") == 0)
+    P->iteration = DM_ITER_FIXED;
+  else
+    return dm_err_set(e, DM_EINVAL, "option 'iteration' must be \"auto\", \"newton\" or "
+                      "\"fixed\", got \"%s\"", name);
+  P->fixed_ok = 0;
+  if (P->iteration == DM_ITER_NEWTON || P->explicit_sv ||
+      (P->iteration == DM_ITER_AUTO && P->n <= DM_PRK_FIXED_MIN))
+    return DM_OK;
+  dm_err le;
+  int st = P->m == 0 ? dm_prk_mass_setup(P, &le)
+                     : dm_err_set(&le, DM_EUNSUP, "the system has constraints");
+  if (st == DM_ENOMEM) {
+    if (e != NULL)
+      *e = le;
+    return st;
+  }
+  if (st != DM_OK && P->iteration == DM_ITER_FIXED)
+    return dm_err_set(e, DM_EINVAL, "iteration = \"fixed\" needs a separable Lagrangian "
+                      "1/2 v^T M v - V(q) without forces or constraints: %s", le.msg);
+  P->fixed_ok = st == DM_OK;
+  return DM_OK;
+}
+
 int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
 {
   dm_prk *P;
@@ -682,6 +895,11 @@ int dm_prk_type_setup(dm_integrator *I, const dm_tableau *t, dm_err *e)
     return st;
   I->state = P;
   P->simplified = I->opt.simplified;
+  if ((st = fixed_setup(P, I->opt.iteration, e)) != DM_OK) {
+    dm_prk_free(P);
+    I->state = NULL;
+    return st;
+  }
   I->stats.linear = P->sparse ? DM_LINEAR_SPARSE : DM_LINEAR_DENSE;
   I->stats.nnz = P->sparse ? dm_prk_sparse_nnz(P) : 0;
   I->order = t->order;

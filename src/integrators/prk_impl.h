@@ -29,6 +29,12 @@ struct dm_prk {
   double tol;
   int maxiter;
   int simplified;              /* reuse the factored Jacobian while converging fast */
+  /* fixed-point iteration V_i <- M^{-1} (p0 + h sum_j at_ij W_j) before
+   * Newton (separable, unforced, unconstrained systems): iteration mode,
+   * whether it applies, steps left before it is tried again */
+  int iteration;               /* enum dm_iteration_mode */
+  int fixed_ok;
+  long fixed_backoff;
   int njac;                    /* Jacobian factorisations in the last solve */
   double lvv_norm;             /* max |Lvv| over the stages, set with the Jacobian */
   /* constraints: multipliers at the stages K (interior stages of a Lobatto
@@ -56,6 +62,8 @@ struct dm_prk {
   double *E;                   /* s x s extrapolation matrix */
   double *cq, *cp;             /* Kahan carries */
   /* separable systems */
+  int mass_ready;              /* dm_prk_mass_setup has filled what follows */
+  double mass_norm;            /* max |M_ij| */
   double *Mdiag;               /* n: the diagonal of M^{-1} */
   double *Minv;                /* n x n, a full mass only (malloc'ed) */
   int mass_kind;               /* DM_MASS_UNIT / _DIAG / _FULL: how M^{-1} applies */
@@ -112,6 +120,7 @@ int dm_composition_coeffs(const char *scheme, int order, double *g, size_t *s,
                           int *order_out, dm_err *e);
 
 /* verlet.c */
+int dm_prk_mass_setup(dm_prk *P, dm_err *e);
 int dm_prk_verlet_setup(dm_prk *P, dm_err *e);
 int dm_prk_verlet_step(dm_prk *P, double h, const double *q0, const double *p0,
                        int cont, double *q1, double *p1, dm_integ_stats *st, dm_err *e);

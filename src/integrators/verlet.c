@@ -29,25 +29,32 @@ static int is_lobatto2(const dm_tableau *t)
 /* The mass's structure (unit, diagonal, full: from the dense matrix, or
  * from the pattern of a large system, whose mass is diagonal), its
  * inverse's diagonal exactly (reciprocals), and for a full mass the
- * inverse by Cholesky. */
-int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
+ * inverse by Cholesky; the largest entry of M.  DM_EUNSUP when the system
+ * is not separable and unforced with a known mass (nothing set), DM_EINVAL
+ * when the mass is not symmetric positive definite. */
+int dm_prk_mass_setup(dm_prk *P, dm_err *e)
 {
   const dm_system *sys = P->sys;
   const dm_sys_pattern *pat = sys->pattern;
   const double *M = sys->mass;
   size_t n = P->n, i;
-  P->explicit_sv = 0;
-  if (!is_lobatto2(P->tab) || !(sys->flags & DM_SYS_SEPARABLE) || P->forced ||
-      (M == NULL && (pat == NULL || pat->mass == NULL || pat->vv.nnz != n)))
+  if (P->mass_ready)
     return DM_OK;
+  if (!(sys->flags & DM_SYS_SEPARABLE) || P->forced ||
+      (M == NULL && (pat == NULL || pat->mass == NULL || pat->vv.nnz != n)))
+    return dm_err_set(e, DM_EUNSUP, "system '%s' has no constant mass matrix (L is not "
+                      "1/2 v^T M v - V(q) without forces)", sys->name ? sys->name : "?");
   P->mass_kind = DM_MASS_UNIT;
+  P->mass_norm = 0.0;
   int spd = 1;
   if (M != NULL) {
-    for (i = 0; i < n * n; i++)
+    for (i = 0; i < n * n; i++) {
       if (i / n != i % n && M[i] != 0.0)
         P->mass_kind = DM_MASS_FULL;
       else if (i / n == i % n && M[i] != 1.0 && P->mass_kind == DM_MASS_UNIT)
         P->mass_kind = DM_MASS_DIAG;
+      P->mass_norm = fmax(P->mass_norm, fabs(M[i]));
+    }
     for (i = 0; i < n; i++) {
       spd &= M[i * n + i] > 0.0 && isfinite(M[i * n + i]);
       P->Mdiag[i] = 1.0 / M[i * n + i];
@@ -59,6 +66,7 @@ int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
       if (mi != 1.0)
         P->mass_kind = DM_MASS_DIAG;
       P->Mdiag[i] = 1.0 / mi;
+      P->mass_norm = fmax(P->mass_norm, fabs(mi));
     }
   }
   if (P->mass_kind == DM_MASS_FULL) {
@@ -70,9 +78,26 @@ int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
     spd = gsl_linalg_cholesky_decomp1(&Mi.matrix) == 0 &&
           gsl_linalg_cholesky_invert(&Mi.matrix) == 0;
   }
-  if (!spd)
+  if (!spd) {
+    free(P->Minv);
+    P->Minv = NULL;
     return dm_err_set(e, DM_EINVAL, "system '%s' is flagged separable but its mass matrix is not "
                       "symmetric positive definite", sys->name ? sys->name : "?");
+  }
+  P->mass_ready = 1;
+  return DM_OK;
+}
+
+int dm_prk_verlet_setup(dm_prk *P, dm_err *e)
+{
+  P->explicit_sv = 0;
+  if (!is_lobatto2(P->tab))
+    return DM_OK;
+  int st = dm_prk_mass_setup(P, e);
+  if (st == DM_EUNSUP)
+    return DM_OK;
+  if (st != DM_OK)
+    return st;
   P->explicit_sv = 1;
   return DM_OK;
 }

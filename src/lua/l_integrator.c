@@ -473,6 +473,16 @@ static void push_stats(lua_State *L, const dm_integ_stats *s)
   lua_setfield(L, -2, "iters_total");
   lua_pushinteger(L, s->flagged);
   lua_setfield(L, -2, "flagged");
+  lua_pushinteger(L, s->fixed_total);
+  lua_setfield(L, -2, "fixed_steps");
+  if (s->linear != 0) {
+    lua_pushstring(L, s->linear == DM_LINEAR_SPARSE ? "sparse" : "dense");
+    lua_setfield(L, -2, "linear");
+  }
+  if (s->nnz > 0) {
+    lua_pushinteger(L, (lua_Integer)s->nnz);
+    lua_setfield(L, -2, "nnz");
+  }
 }
 
 static int flag_field(lua_State *L, const dm_linteg *li, const char *k)
@@ -652,7 +662,7 @@ static const dm_field integ_fields[] = {
   {"stages", "integ.stages -> integer | nil", "The number of stages, for Runge-Kutta type methods."},
   {"order", "integ.order -> integer", "The classical order of the method."},
   {"system", "integ.system -> sys", "The system being integrated."},
-  {"stats", "integ.stats -> table", "Newton statistics of the last step and totals (iters, jacs, residual, tol, steps, iters_total)."},
+  {"stats", "integ.stats -> table", "Newton statistics of the last step and totals (iters, jacs, residual, tol, steps, iters_total; fixed_steps: steps the fixed-point iteration solved alone; linear = \"dense\" | \"sparse\" and nnz: the Newton matrices)."},
   {"summary", "integ.summary -> string", "One line describing the method family."},
   {"symplectic", "integ.symplectic -> boolean", "True for a symplectic method."},
   {"symmetric", "integ.symmetric -> boolean", "True for a symmetric (time-reversible) method."},

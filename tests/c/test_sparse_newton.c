@@ -4,7 +4,10 @@
  * separable, forced (Lagrange-d'Alembert), constrained (Lobatto with
  * multipliers), a system without a pattern (built-in C), in both layouts
  * of the derivatives (dense arrays gathered, values on the pattern); the
- * step Jacobians agree too; the automatic choice and the option's error. */
+ * step Jacobians agree too; the automatic choice and the option's error.
+ * The fixed-point iteration of separable systems (option iteration) gives
+ * Newton's states too, hands over to Newton when it contracts slowly,
+ * and is refused where it does not apply. */
 #include <config.h>
 #include <math.h>
 #include <stdio.h>
@@ -102,9 +105,21 @@ static void start(int kind, size_t n, double *q, double *v)
     }
 }
 
-/* nsteps steps with linear = mode; the end state (q, p) into out. */
+static int run_it(const dm_system *s, const char *method, int stages, const char *mode,
+                  const char *iteration, double h, int nsteps, double *out, int *linear,
+                  long *fixed);
+
+/* nsteps steps with linear = mode (Newton throughout: the linear solves
+ * are what is compared); the end state (q, p) into out. */
 static int run(const dm_system *s, const char *method, int stages, const char *mode,
                int nsteps, double *out, int *linear)
+{
+  return run_it(s, method, stages, mode, "newton", 0.02, nsteps, out, linear, NULL);
+}
+
+static int run_it(const dm_system *s, const char *method, int stages, const char *mode,
+                  const char *iteration, double h, int nsteps, double *out, int *linear,
+                  long *fixed)
 {
   dm_integ_opts o;
   dm_integrator *I = NULL;
@@ -115,6 +130,7 @@ static int run(const dm_system *s, const char *method, int stages, const char *m
   o.stages = stages;
   o.explicit_sv = 0;
   snprintf(o.linear, sizeof o.linear, "%s", mode);
+  snprintf(o.iteration, sizeof o.iteration, "%s", iteration);
   if (dm_integrator_new(s, method, &o, &I, &e) != DM_OK) {
     tap_diag("%s: %s", method, e.msg);
     return -1;
@@ -128,12 +144,14 @@ static int run(const dm_system *s, const char *method, int stages, const char *m
   }
   int st = dm_integrator_momentum(I, q, v, p, &e);
   for (int k = 0; k < nsteps && st == DM_OK; k++)
-    st = dm_integrator_step(I, 0.02, q, p, q, p, &e);
+    st = dm_integrator_step(I, h, q, p, q, p, &e);
   if (st != DM_OK)
     tap_diag("%s step: %s", mode, e.msg);
   memcpy(out, q, n * sizeof *q);
   memcpy(out + n, p, n * sizeof *p);
   *linear = I->stats.linear;
+  if (fixed != NULL)
+    *fixed = I->stats.fixed_total;
   dm_integrator_free(I);
   return st;
 }
@@ -231,6 +249,61 @@ int main(void)
     tap_ok(st == DM_EINVAL && strstr(e.msg, "'linear'") && strstr(e.msg, "banded"),
            "linear = banded: %s", e.msg);
     dm_system_release(&s);
+  }
+  /* the fixed-point iteration: the same stages as Newton's */
+  {
+    double a[2 * NMAX], b[2 * NMAX];
+    int lin;
+    long fa = -1, fb = -1;
+    make_system(1, 40, DM_LAG_LAYOUT_AUTO, &s);
+    static const char *const meth[] = { "gauss", "lobatto" };
+    for (int k = 0; k < 2; k++) {
+      int sa = run_it(&s, meth[k], 3 - k, "auto", "auto", 0.02, 200, a, &lin, &fa);
+      int sb = run_it(&s, meth[k], 3 - k, "auto", "newton", 0.02, 200, b, &lin, &fb);
+      tap_ok(sa == DM_OK && sb == DM_OK && fa == 200 && fb == 0 && rel(a, b, 80) <= 1e-12,
+             "separable chain of 40, %s: fixed-point iteration (%ld of 200 steps) = Newton "
+             "(rel. diff %.2g)", meth[k], fa, rel(a, b, 80));
+    }
+    /* large steps: the iteration contracts slowly, Newton takes over */
+    int sa = run_it(&s, "gauss", 2, "auto", "auto", 0.6, 50, a, &lin, &fa);
+    int sb = run_it(&s, "gauss", 2, "auto", "newton", 0.6, 50, b, &lin, &fb);
+    tap_ok(sa == DM_OK && sb == DM_OK && fa < 50 && rel(a, b, 80) <= 1e-12,
+           "h = 0.6: Newton takes over when the iteration is slow (fixed alone in %ld of 50 "
+           "steps), the same states (rel. diff %.2g)", fa, rel(a, b, 80));
+    dm_system_release(&s);
+    /* forced on a small system with a diagonal mass */
+    make_system(1, 10, DM_LAG_LAYOUT_DENSE, &s);
+    sa = run_it(&s, "gauss", 2, "auto", "fixed", 0.02, 100, a, &lin, &fa);
+    sb = run_it(&s, "gauss", 2, "auto", "newton", 0.02, 100, b, &lin, &fb);
+    tap_ok(sa == DM_OK && sb == DM_OK && fa == 100 && rel(a, b, 20) <= 1e-12,
+           "iteration = fixed on 10 coordinates: the same states (rel. diff %.2g)",
+           rel(a, b, 20));
+    sa = run_it(&s, "gauss", 2, "auto", "auto", 0.02, 10, a, &lin, &fa);
+    tap_ok(sa == DM_OK && fa == 0, "auto: Newton alone up to 32 coordinates");
+    dm_system_release(&s);
+    /* the systems it does not apply to; the option's error */
+    static const char *const why[] = { "gyroscopic", "", "forced" };
+    for (int kind = 0; kind <= 3; kind++) {
+      if (kind == 1 || make_system(kind, 8, DM_LAG_LAYOUT_AUTO, &s) != DM_OK)
+        continue;
+      dm_integ_opts o;
+      dm_integrator *I = NULL;
+      dm_err e;
+      dm_integ_opts_init(&o);
+      strcpy(o.iteration, "fixed");
+      const char *method = kind == 3 ? "lobatto" : "gauss";
+      int st = dm_integrator_new(&s, method, &o, &I, &e);
+      tap_ok(st == DM_EINVAL && strstr(e.msg, "iteration = \"fixed\" needs a separable"),
+             "iteration = fixed on a %s system: %s", kind == 3 ? "constrained" : why[kind],
+             e.msg);
+      if (kind == 3) {
+        strcpy(o.iteration, "quick");
+        st = dm_integrator_new(&s, method, &o, &I, &e);
+        tap_ok(st == DM_EINVAL && strstr(e.msg, "'iteration'") && strstr(e.msg, "quick"),
+               "iteration = quick: %s", e.msg);
+      }
+      dm_system_release(&s);
+    }
   }
   dm_expr_ctx_free(C);
   return tap_done();
