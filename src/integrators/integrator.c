@@ -41,8 +41,9 @@ const dm_option_desc dm_integ_options[] = {
   {"linear", DM_OPT_STRING, OPT(linear), 0, 0,
    "Newton matrices: dense LU, sparse LU (KLU) or auto (default: sparse for large sparse systems)"},
   {"iteration", DM_OPT_STRING, OPT(iteration), 0, 0,
-   "stage equations: newton, fixed (fixed-point iteration on a separable L, Newton when it "
-   "contracts slowly) or auto (default: fixed above 32 coordinates)"},
+   "stage equations: newton, or fixed (a fixed-point iteration on a separable L, Newton "
+   "when it contracts slowly; an error on other systems), auto (default: fixed where it "
+   "applies)"},
   {NULL, 0, 0, 0, 0, 0, NULL}
 };
 #undef OPT

@@ -141,6 +141,7 @@ static void fast_paths(void)
   dm_integrator_free(I);
 
   dm_integ_opts_init(&o);
+  strcpy(o.iteration, "newton");          /* Newton, not the fixed-point iteration */
   dm_integrator_new(&kep, "gauss", &o, &I, NULL);
   o.simplified = 0;
   dm_integrator_new(&kep, "gauss", &o, &F, NULL);
