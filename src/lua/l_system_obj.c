@@ -332,10 +332,25 @@ static int system_tostring(lua_State *L)
   lua_pushfstring(L, "<system '%s': %d coords (", ls->sys.name, (int)ls->n);
   luaL_addvalue(&b);
   for (size_t i = 0; i < ls->n; i++) {
-    luaL_addstring(&b, ls->sys.coords[i]);
+    const struct dm_lcoordarray *G = NULL;
+    for (size_t g = 0; g < ls->ngroups; g++)
+      if (ls->groups[g].first == i && ls->groups[g].count > 0)
+        G = &ls->groups[g];
+    if (G != NULL) {                  /* an array: x[1..n], not n names */
+      lua_pushfstring(L, "%s[1..%d]", G->name, (int)G->count);
+      luaL_addvalue(&b);
+      i += G->count - 1;
+    }
+    else
+      luaL_addstring(&b, ls->sys.coords[i]);
     luaL_addstring(&b, i + 1 < ls->n ? ", " : ")");
   }
   for (size_t i = 0; i < ls->npar; i++) {
+    if (i == 8 && ls->npar > 10) {    /* one line: the first 8 and a count */
+      lua_pushfstring(L, " ... (%d parameters)", (int)ls->npar);
+      luaL_addvalue(&b);
+      break;
+    }
     luaL_addstring(&b, i == 0 ? ", " : " ");
     luaL_addstring(&b, ls->sys.params[i]);
     luaL_addchar(&b, '=');

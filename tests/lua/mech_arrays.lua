@@ -32,6 +32,11 @@ T.is(s2.n, 1 + N + 2, "mixed: names and two arrays")
 T.ok(seen.len == N and tostring(seen.flat) == "x[1]" and tostring(seen.named) == "x[1]" and
      tostring(seen.y2) == "y[2]", "in L: #q.x, q[k] over all coordinates, q[\"x[1]\"], q.y[2]")
 T.like(tostring(s2.L), "v_x%[6%]", "the symbols print as x[i], v_x[i]")
+T.like(tostring(s2), "^<system 'mixed': 9 coords %(theta, x%[1%.%.6%], y%[1%.%.2%]%); ",
+       "tostring names an array once, x[1..n], not its n elements")
+local nb = dm.systems.nbody{n = 12}
+T.like(tostring(nb), "24 coords %(x%[1%.%.12%], y%[1%.%.12%]%), G=1 soft=0 m1=1 .* m6=1 %.%.%. %(14 parameters%)",
+       "many parameters: the first 8 and their count")
 
 -- states by the array's name, and flat
 local I = dm.integrator(a, {method = "gauss", h = 0.01})
