@@ -19,8 +19,8 @@
  * first iterates without any matrix (option iteration, default auto):
  *   V_i <- V_i - M^{-1} R_i = M^{-1} (p0 + h sum_j at_ij W_j),
  * with the same stopping rule; when the updates contract less than
- * DM_PRK_FIXED_RATE per iteration Newton takes over from the iterate
- * reached (and is used alone for the next DM_PRK_FIXED_BACKOFF steps).
+ * DM_PRK_FIXED_RATE per iteration Newton takes over from the predictor
+ * (and is used alone for the next DM_PRK_FIXED_BACKOFF steps).
  * Both converge to the same stages, so they agree to round-off.
  * The predictor extrapolates the previous step's stage-velocity polynomial
  * (nodes c, values V) to the new stage times; without history (or with
@@ -592,13 +592,15 @@ static int fixed_point(dm_prk *P, int mode, double h, const double *q0, const do
       *done = 1;
       break;
     }
-    if (it >= 2 && d > DM_PRK_FIXED_RATE * dlast) {
-      P->fixed_backoff = P->iteration == DM_ITER_AUTO ? DM_PRK_FIXED_BACKOFF : 0;
-      return DM_OK;                     /* slow: Newton goes on from here */
-    }
+    if (it >= 2 && d > DM_PRK_FIXED_RATE * dlast)
+      break;                            /* slow or diverging: Newton from the predictor */
     dlast = d;
   }
   if (!*done) {
+    /* not from the iterate reached: the scaled update stays near 1 while
+     * the iterates grow without bound (h too large), and Newton from
+     * there would start from garbage where alone it finds the stages or
+     * reports the divergence as it always did */
     memcpy(P->X, saved, sn * sizeof(double));
     P->fixed_backoff = P->iteration == DM_ITER_AUTO ? DM_PRK_FIXED_BACKOFF : 0;
     return DM_OK;
