@@ -9,7 +9,10 @@
 -- Per N: the definition (trace + derive + tape, native = "never", thread CPU
 -- ms), Stormer-Verlet ns/step on the tape and native against the
 -- hand-written C leapfrog (bench_scale.c), Gauss s=2 ns/step on the tape and
--- native, the first native compile with an empty cache (dm.system with
+-- native (the default: the fixed-point iteration for these separable
+-- systems), then Gauss s=2 native with Newton forced (iteration = "newton")
+-- on the sparse KLU matrices and on the dense LU (linear = "sparse" and
+-- "dense"), the first native compile with an empty cache (dm.system with
 -- native = "always" minus the definition: CPU s of dmech and the C
 -- compilers, and wall s), and the wall time from the start of dm.system to
 -- the end of the first step with native = "auto" and an empty cache (a
@@ -214,18 +217,18 @@ local function bench_kind(key)
   local K = kinds[key]
   print(K.name)
   local cols = {}
-  local keys = {"def", "sv_tape", "sv_nat", "sv_hand", "g2_tape", "g2_nat", "compile", "cwall",
-                "first"}
+  local keys = {"def", "sv_tape", "sv_nat", "sv_hand", "g2_tape", "g2_nat", "g2_sp", "g2_dn",
+                "compile", "cwall", "first"}
   for _, k in ipairs(keys) do cols[k] = {} end
   -- each column holds the seconds one measurement takes (3 steps for the
   -- per-step ones): the budget extrapolates them; the exponents are those
   -- of the per-step costs
   local function want(k, N) return affordable(cols[k], N) end
-  local hfmt = "  %6s %9s %9s %9s %9s %6s %11s %11s %7s %8s %8s %9s %8s"
+  local hfmt = "  %6s %9s %9s %9s %9s %6s %11s %11s %7s %11s %11s %8s %8s %9s %8s"
   print(hfmt:format("N", "define", "SV tape", "SV native", "SV C", "nat/C", "G2 tape",
-    "G2 native", "G2/SV", "compile", "compile", "1st step", "|dq|"))
+    "G2 native", "G2/SV", "G2 KLU", "G2 dense", "compile", "compile", "1st step", "|dq|"))
   print(hfmt:format("", "ms", "ns/step", "ns/step", "ns/step", "", "ns/step", "ns/step", "",
-    "CPU s", "wall s", "wall s", ""))
+    "ns/step", "ns/step", "CPU s", "wall s", "wall s", ""))
   for _, N in ipairs(K.Ns) do
     if N > maxN then break end
     local row = {N = N}
@@ -289,9 +292,20 @@ local function bench_kind(key)
       if want("g2_nat", N) then
         row.g2_nat = per_step(dm.integrator(nsys, g2), s0, 1)
       end
+      -- Newton with either linear solver (a tree without the options
+      -- errs: "-")
+      for _, lin in ipairs{{"g2_sp", "sparse"}, {"g2_dn", "dense"}} do
+        if want(lin[1], N) then
+          local ok, I2 = pcall(dm.integrator, nsys, {method = "gauss", stages = 2, h = K.h,
+                                                     iteration = "newton", linear = lin[2]})
+          if ok then row[lin[1]] = per_step(I2, s0, 1) end
+        end
+      end
     end
     table.insert(cols.sv_nat, {N = N, v = row.sv_nat and row.sv_nat * 3e-9})
     table.insert(cols.g2_nat, {N = N, v = row.g2_nat and row.g2_nat * 3e-9})
+    table.insert(cols.g2_sp, {N = N, v = row.g2_sp and row.g2_sp * 3e-9})
+    table.insert(cols.g2_dn, {N = N, v = row.g2_dn and row.g2_dn * 3e-9})
     nsys = nil
     collectgarbage()
     -- the first step after the definition, native = "auto", an empty cache
@@ -312,7 +326,8 @@ local function bench_kind(key)
       fmt(row.def and row.def * 1e3), fmt(row.sv_tape, "%.0f"), fmt(row.sv_nat, "%.0f"),
       fmt(row.sv_hand, "%.0f"), fmt(row.sv_nat and row.sv_nat / row.sv_hand, "%.2f"),
       fmt(row.g2_tape, "%.0f"), fmt(row.g2_nat, "%.0f"),
-      fmt(g2best and svbest and g2best / svbest, "%.1f"), fmt(row.compile, "%.2f"),
+      fmt(g2best and svbest and g2best / svbest, "%.1f"), fmt(row.g2_sp, "%.0f"),
+      fmt(row.g2_dn, "%.0f"), fmt(row.compile, "%.2f"),
       fmt(row.cwall, "%.2f"), fmt(row.first, "%.3f"), fmt(row.dq, "%.0e")))
     io.stdout:flush()
   end
@@ -321,8 +336,9 @@ local function bench_kind(key)
     return fmt(fit(cols[k], from), "%.2f")
   end
   print(("  fitted exponents (N >= %d): define %s, SV tape %s, SV native %s, SV C %s, "
-         .. "G2 tape %s, G2 native %s, compile CPU %s"):format(from, ex("def"), ex("sv_tape"),
-         ex("sv_nat"), ex("sv_hand"), ex("g2_tape"), ex("g2_nat"), ex("compile")))
+         .. "G2 tape %s, G2 native %s, G2 KLU %s, G2 dense %s, compile CPU %s"):format(from,
+         ex("def"), ex("sv_tape"), ex("sv_nat"), ex("sv_hand"), ex("g2_tape"), ex("g2_nat"),
+         ex("g2_sp"), ex("g2_dn"), ex("compile")))
   print()
 end
 
