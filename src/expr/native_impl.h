@@ -3,6 +3,7 @@
 #ifndef DM_NATIVE_IMPL_H
 #define DM_NATIVE_IMPL_H
 
+#include <stdatomic.h>
 #include "expr/native.h"
 
 #define CC_FLAGS "-O1 -fPIC -shared -ffp-contract=off -fno-math-errno"
@@ -72,7 +73,8 @@ int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const 
 void dm_native__remove_units(const char *dir, size_t n);
 /* The compilations started by this thread stop when *flag becomes
  * non-zero (background jobs) instead of at dm_interrupted() (NULL, the
- * default: the foreground). */
-void dm_native__set_cancel(const volatile int *flag);
+ * default: the foreground).  The flag is atomic: another thread sets it
+ * while this one polls it. */
+void dm_native__set_cancel(const atomic_int *flag);
 
 #endif

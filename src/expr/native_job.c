@@ -17,7 +17,7 @@ struct dm_native_job {
   dm_native_map *inmap, *outmap;
   size_t nmap;
   char *cc, *tmpdir;        /* the environment at the start */
-  volatile int cancel;      /* read by the compiler runs of the worker */
+  atomic_int cancel;        /* set under mu, polled by the worker's compiler runs */
   int state;                /* under mu */
   int status;
   dm_err err;
@@ -50,10 +50,12 @@ static void *worker(void *arg)
     dm_native *nat = NULL;
     dm_err e;
     dm_err_clear(&e);
-    int st = job->cancel ? dm_err_set(&e, DM_EINTR, "native: compilation cancelled")
+    int st = atomic_load(&job->cancel)
+             ? dm_err_set(&e, DM_EINTR, "native: compilation cancelled")
              : dm_native__compile_with(job->t, job->in0, job->par0, job->inmap, job->nmap,
                                        job->outmap, &(dm_native_env){ job->cc, job->tmpdir },
                                        &nat, &e);
+    dm_native__set_cancel(NULL);            /* the job may be freed once done */
 
     pthread_mutex_lock(&mu);
     job->nat = nat;
@@ -74,7 +76,7 @@ static void at_exit(void)
   exiting = 1;
   head = tail = NULL;
   if (current != NULL)
-    current->cancel = 1;
+    atomic_store(&current->cancel, 1);
   for (int i = 0; i < 40 && current != NULL; i++) {
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
@@ -206,7 +208,7 @@ static void unqueue(dm_native_job *job)
  * compiler has been stopped. */
 static void cancel_locked(dm_native_job *job)
 {
-  job->cancel = 1;
+  atomic_store(&job->cancel, 1);
   if (job->state == DM_NATIVE_JOB_QUEUED) {
     unqueue(job);
     job->state = DM_NATIVE_JOB_FAILED;
@@ -218,7 +220,7 @@ int dm_native_job_wait(dm_native_job *job, int interruptible, dm_err *err)
 {
   pthread_mutex_lock(&mu);
   while (job->state == DM_NATIVE_JOB_QUEUED || job->state == DM_NATIVE_JOB_RUNNING) {
-    if (interruptible && dm_interrupted() && !job->cancel)
+    if (interruptible && dm_interrupted() && !atomic_load(&job->cancel))
       cancel_locked(job);
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);

@@ -28,9 +28,9 @@ extern char **environ;
 /* What stops this thread's compilations: the interrupt flag (foreground)
  * or a job's cancel flag (background threads must not die of a Ctrl-C
  * meant for the computation in the foreground). */
-static _Thread_local const volatile int *tl_cancel, *tl_stop;
+static _Thread_local const atomic_int *tl_cancel, *tl_stop;
 
-void dm_native__set_cancel(const volatile int *flag)
+void dm_native__set_cancel(const atomic_int *flag)
 {
   tl_cancel = flag;
 }
@@ -38,8 +38,8 @@ void dm_native__set_cancel(const volatile int *flag)
 /* tl_stop: a failure in a sibling compilation (dm_native__build_units) */
 static int cancelled(void)
 {
-  return (tl_cancel != NULL ? *tl_cancel != 0 : dm_interrupted()) ||
-         (tl_stop != NULL && *tl_stop != 0);
+  return (tl_cancel != NULL ? atomic_load(tl_cancel) != 0 : dm_interrupted()) ||
+         (tl_stop != NULL && atomic_load(tl_stop) != 0);
 }
 
 
@@ -551,8 +551,8 @@ typedef struct unit_job {
   char *const *src;
   size_t n, next;           /* units; the next one to take */
   pthread_mutex_t mu;
-  const volatile int *cancel;   /* the starting thread's */
-  volatile int stop;        /* set by the first failure */
+  const atomic_int *cancel;     /* the starting thread's */
+  atomic_int stop;          /* set by the first failure (under mu), polled */
   int status;
   dm_err err;
 } unit_job;
@@ -589,12 +589,12 @@ static int compile_unit(unit_job *J, size_t k, dm_err *err)
 static void *unit_worker(void *arg)
 {
   unit_job *J = arg;
-  const volatile int *save = tl_cancel, *save2 = tl_stop;
+  const atomic_int *save = tl_cancel, *save2 = tl_stop;
   tl_cancel = J->cancel;
   tl_stop = &J->stop;
   for (;;) {
     pthread_mutex_lock(&J->mu);
-    size_t k = J->next < J->n && !J->stop ? J->next++ : J->n;
+    size_t k = J->next < J->n && !atomic_load(&J->stop) ? J->next++ : J->n;
     pthread_mutex_unlock(&J->mu);
     if (k >= J->n)
       break;
@@ -604,7 +604,7 @@ static void *unit_worker(void *arg)
     if (s != DM_OK && J->status == DM_OK) {
       J->status = s;
       J->err = e;
-      J->stop = 1;
+      atomic_store(&J->stop, 1);
     }
     pthread_mutex_unlock(&J->mu);
   }
@@ -657,6 +657,7 @@ int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const 
   J.src = src;
   J.n = n;
   J.cancel = tl_cancel;
+  atomic_init(&J.stop, 0);
   pthread_mutex_init(&J.mu, NULL);
   enum { MAXPAR = 8 };
   pthread_t th[MAXPAR];
