@@ -1,6 +1,6 @@
 /* b_adapt.c -- adaptive steps that keep the structure, against GSL's
  * adaptive rk8pd, on the eccentric Kepler orbit (doc/benchmarks.md, B6;
- * doc/galerkin.md §3): 1000 periods at e = 0.6, 0.9, 0.99 from the
+ * doc/beyond-fixed-steps.md §3): 1000 periods at e = 0.6, 0.9, 0.99 from the
  * pericentre (q0 = (1 - e, 0), p0 = (0, sqrt((1 + e)/(1 - e))), a = 1).
  *
  * dmech: the time-transformed order-8 composition (adapt:composition,

@@ -1,5 +1,5 @@
 -- kepler_adaptive.lua -- adaptive steps that keep the structure
--- (doc/galerkin.md §3): a time transformation dt/ds = g(q) with fixed steps
+-- (doc/beyond-fixed-steps.md §3): a time transformation dt/ds = g(q) with fixed steps
 -- in the fictitious time s, on the Kepler orbit of eccentricity 0.9.
 --   kepler_adaptive.png   (a) every step of one orbit; (b) the physical
 --                         step against the distance r (monitor r^1.5: slope

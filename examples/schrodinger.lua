@@ -1,5 +1,5 @@
 -- schrodinger.lua -- the pseudospectral variational integrator for the
--- Schrodinger equation (doc/galerkin.md §6): a coherent state in a harmonic
+-- Schrodinger equation (doc/beyond-fixed-steps.md §6): a coherent state in a harmonic
 -- trap V = w^2 (x - pi)^2/2 on the periodic [0, 2 pi), 65 Fourier modes.
 --   schrodinger.png   (a) |psi|^2 over half a period: the packet moves
 --                     without spreading; (b) <x>(t) against pi + a cos(w t);

@@ -1,4 +1,4 @@
--- sine_gordon.lua -- a multisymplectic variational integrator (doc/galerkin.md
+-- sine_gordon.lua -- a multisymplectic variational integrator (doc/beyond-fixed-steps.md
 -- §5): the sine-Gordon equation u_tt = u_xx - sin u on a space-time grid
 -- (bilinear elements, one-point rule), a kink and an antikink colliding
 -- (the exact Perring-Skyrme solution u = 4 atan(sinh(g v t)/(v cosh(g x)))).

@@ -1,4 +1,4 @@
--- stiff_pendulum.lua -- a multiscale variational integrator (doc/galerkin.md
+-- stiff_pendulum.lua -- a multiscale variational integrator (doc/beyond-fixed-steps.md
 -- §4): the planar pendulum on a stiff spring, L = m(a'^2 + (l + a)^2 th'^2)/2
 -- + m g (l + a) cos th - k a^2/2, with the fast energy fixed as the
 -- stiffness k grows from 1e4 to 1e8, integrated to T = 3 with the same step

@@ -1,5 +1,5 @@
 /* msfem.c -- the 1-D multiscale finite element method exact at the nodes
- * (doc/galerkin.md §4.1; thesis appendix C) and the standard linear
+ * (doc/beyond-fixed-steps.md §4.1; thesis appendix C) and the standard linear
  * elements it is compared with.  Quadrature: GSL QAG (adaptive
  * Gauss-Kronrod 61); the tridiagonal system: gsl_linalg_solve_symm_tridiag.
  * See fields.h. */

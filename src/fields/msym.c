@@ -2,7 +2,7 @@
  * l = u_t^2/2 - c^2 u_x^2/2 - V(u) on a space-time grid: bilinear elements,
  * the one-point (cell-centre) rule, the step of a time slab in position-
  * momentum form, its derivative, and the discrete multisymplectic form
- * formula checked cell by cell and node by node (doc/galerkin.md §5).
+ * formula checked cell by cell and node by node (doc/beyond-fixed-steps.md §5).
  * See fields.h. */
 #include <config.h>
 #include "fields/fields.h"

@@ -1,7 +1,7 @@
 /* msym_dec.c -- the multisymplectic integrator of the nonlinear wave
  * equation with DEC in space: u a primal 0-cochain, the stiffness
  * S = *0 Delta_0 = d0^T *1 d0 and the mass *0 of src/dec, the midpoint rule
- * in time over each space-time prism (doc/galerkin.md §5.3).  The constant
+ * in time over each space-time prism (doc/beyond-fixed-steps.md §5.3).  The constant
  * SPD part of the Newton matrix is factored once by CHOLMOD.  See fields.h. */
 #include <config.h>
 #include "fields/fields.h"

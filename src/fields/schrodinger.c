@@ -1,5 +1,5 @@
 /* schrodinger.c -- the pseudospectral variational integrator for the
- * Schrodinger equation (doc/galerkin.md §6): the Galerkin Hamiltonian from
+ * Schrodinger equation (doc/beyond-fixed-steps.md §6): the Galerkin Hamiltonian from
  * an FFT of V (FFTW), its eigenpairs (GSL), Milne-Simpson, Crank-Nicolson
  * and exact steps with one LU factorisation (GSL), runs with norm, energy,
  * <x>, <p>.  See fields.h. */

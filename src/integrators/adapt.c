@@ -1,7 +1,7 @@
 /* adapt.c -- time-transformed integrators "adapt:<method>": the Poincare
  * transformation as a Lagrangian system of (q, t) that any registered
  * method integrates, and the explicit path for separable systems with the
- * potential's monitor.  See adapt.h and doc/galerkin.md §3. */
+ * potential's monitor.  See adapt.h and doc/beyond-fixed-steps.md §3. */
 #include <config.h>
 #include "integrators/adapt_impl.h"
 #include "core/interrupt.h"
@@ -69,7 +69,7 @@ static int monitor_eval(const tt_data *d, const double *q, const double *par, un
 /* {==== the transformed Lagrangian ======================================= */
 
 /* L~(q, t, w, s) = g (L(q, u) + E0) + pi^2/2, u = w/g, pi = s - g, where the
- * derivatives follow from the chain rule with E = Lv.u - L (doc/galerkin.md
+ * derivatives follow from the chain rule with E = Lv.u - L (doc/beyond-fixed-steps.md
  * §3.2):
  *   L~_q  = g Lq - gq (E - E0) - pi gq,     L~_w = Lv,   L~_s = pi,
  *   L~_ww = Lvv/g,  L~_ss = 1,  L~_wq = Lvq - (Lvv u) gq^T/g,  L~_sq = -gq,

@@ -1,5 +1,5 @@
 /* adapt.h -- structure-preserving adaptive steps by a time transformation
- * (methods "adapt:<method>", doc/galerkin.md §3).
+ * (methods "adapt:<method>", doc/beyond-fixed-steps.md §3).
  *
  * The physical time runs as dt/ds = g(q) > 0 in a fictitious time s in
  * which the steps are fixed.  With the energy E0 of the start latched, the

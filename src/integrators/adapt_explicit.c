@@ -2,7 +2,7 @@
  * Stormer-Verlet (drift-kick-drift) and its compositions on the separable
  * extended Hamiltonian f(T(p) + p_t) - f(U(q)) with f' = g(U) = (U0/U)^a,
  * which on the energy surface p_t = -E0 is the flow of the Poincare
- * transformation with the potential's monitor (doc/galerkin.md §3.3).
+ * transformation with the potential's monitor (doc/beyond-fixed-steps.md §3.3).
  * See adapt.h. */
 #include <config.h>
 #include "integrators/adapt_impl.h"

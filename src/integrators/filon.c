@@ -1,6 +1,6 @@
 /* filon.c -- Filon weights for the Lagrange basis of any nodes and the
  * phase-sampled weight matrix of the multiscale integrators
- * (doc/galerkin.md §4.2).  See multiscale.h. */
+ * (doc/beyond-fixed-steps.md §4.2).  See multiscale.h. */
 #include <config.h>
 #include "integrators/multiscale.h"
 

@@ -1,7 +1,7 @@
 /* multiscale.c -- the multiscale variational integrator: a Galerkin
  * discrete action over curves with oscillatory bubbles in the fast
  * coordinates, integrated by the Filon-Lobatto phase-sampled rule, solved
- * in nodal form by Newton with the exact Hessian (doc/galerkin.md §4.3);
+ * in nodal form by Newton with the exact Hessian (doc/beyond-fixed-steps.md §4.3);
  * the estimate of the fast frequency.  See multiscale.h. */
 #include <config.h>
 #include "integrators/multiscale.h"

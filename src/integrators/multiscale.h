@@ -1,5 +1,5 @@
 /* multiscale.h -- multiscale variational integrators (method "multiscale",
- * doc/galerkin.md §4) and the Filon-Lobatto phase-sampled quadrature they
+ * doc/beyond-fixed-steps.md §4) and the Filon-Lobatto phase-sampled quadrature they
  * integrate with.
  *
  * The step is the nodal Galerkin step of a discrete action S over a space

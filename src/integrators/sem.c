@@ -1,6 +1,6 @@
 /* sem.c -- symplectic-energy-momentum integrators: the Gauss Galerkin
  * discrete Lagrangian with the step size as an unknown fixed by the
- * discrete energy (see sem.h, doc/galerkin.md §2).
+ * discrete energy (see sem.h, doc/beyond-fixed-steps.md §2).
  *
  * Unknowns: the stage velocities V (s n) and h.  Equations, with
  * Q_i = q0 + h sum_j a_ij V_j,

@@ -1,5 +1,5 @@
 /* sem.h -- symplectic-energy-momentum integrators (method "sem", stages s;
- * doc/galerkin.md §2).
+ * doc/beyond-fixed-steps.md §2).
  *
  * The step size is an unknown of the discrete variational principle: with
  * the Galerkin discrete Lagrangian Ld(q0, q1, h) of the Gauss s-stage

@@ -1,5 +1,5 @@
 /* test_adapt.c -- time-transformed integrators "adapt:<method>"
- * (doc/galerkin.md §3) on the Kepler problem e = 0.9 against Kepler's
+ * (doc/beyond-fixed-steps.md §3) on the Kepler problem e = 0.9 against Kepler's
  * equation: orders of the transformed methods (implicit Poincare path with
  * a user monitor r^1.5, explicit path with the potential's monitor),
  * symplecticity defect of the step in the extended phase space (q, t, p,

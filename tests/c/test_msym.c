@@ -1,5 +1,5 @@
 /* test_msym.c -- multisymplectic integrators of the nonlinear wave equation
- * (doc/galerkin.md §5): the dispersion relation of plane waves on the grid
+ * (doc/beyond-fixed-steps.md §5): the dispersion relation of plane waves on the grid
  * and on a DEC ring, order 2 of a standing wave, the discrete
  * multisymplectic form formula checked cell by cell, node by node and
  * level by level (sine-Gordon), the sine-Gordon kink against the exact

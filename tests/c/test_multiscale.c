@@ -1,4 +1,4 @@
-/* test_multiscale.c -- multiscale variational integration (doc/galerkin.md
+/* test_multiscale.c -- multiscale variational integration (doc/beyond-fixed-steps.md
  * §4): the 1-D multiscale finite elements exact at the nodes (against the
  * exact solution; linear elements homogenise wrongly), the Filon weights
  * (values, Simpson at theta = 0, an oscillatory integral at w = 10..1000,

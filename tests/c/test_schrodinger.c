@@ -1,5 +1,5 @@
 /* test_schrodinger.c -- the pseudospectral variational integrator for the
- * Schrodinger equation (doc/galerkin.md §6): one mode (Milne-Simpson error
+ * Schrodinger equation (doc/beyond-fixed-steps.md §6): one mode (Milne-Simpson error
  * against T E^5 dt^4/180 and order 4, Crank-Nicolson order 2 and its norm,
  * the stability bound dt E/hbar <= sqrt 3 from both sides), the free
  * particle mode by mode, the harmonic oscillator's eigenvalues w(n + 1/2)

@@ -1,4 +1,4 @@
-/* test_sem.c -- symplectic-energy-momentum integrators (doc/galerkin.md §2):
+/* test_sem.c -- symplectic-energy-momentum integrators (doc/beyond-fixed-steps.md §2):
  * the pendulum with midpoint SEM (step range, the discrete energy
  * recomputed from the trajectory in closed form, energy error maxima,
  * order 2 at the reached time), the harmonic oscillator (constant steps),
