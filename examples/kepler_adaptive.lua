@@ -60,7 +60,7 @@ print(string.format("one orbit, Gauss s=2, monitor r^1.5, h = 0.02: %d steps, ph
 
 -- {== (c): error after 100 periods against CPU time
 local curves = {}
-local function sweep(label, make, values, opts)
+local function sweep(label, key, make, values, opts)
   local cx, cy = {}, {}
   for _, v in ipairs(values) do
     local tr, cpu = timed(make(v), opts)
@@ -68,21 +68,21 @@ local function sweep(label, make, values, opts)
     cx[#cx + 1], cy[#cy + 1] = cpu, err
     print(string.format("  %-34s %-10g error %.3e  cpu %.4f s", label, v, err, cpu))
   end
-  curves[#curves + 1] = {cx, cy, title = label, with = "linespoints lw 2"}
+  curves[#curves + 1] = {cx, cy, title = key, with = "linespoints lw 2"}
 end
 print(string.format("error after %d periods (e = %g) against CPU time:", periods, e))
-sweep("adapt, composition order 8", function(N)
+sweep("adapt, composition order 8, N", "adapt, composition order 8", function(N)
   return dm.integrator(kep, {method = "composition", order = 8, h = 2 * math.pi * (1 - e) / N,
                              adapt = true}) end, {8, 11, 16, 22, 32, 45}, {t = T, every = 1e9})
-sweep("adapt, Gauss s=2, r^1.5", function(h)
+sweep("adapt, Gauss s=2, r^1.5, h", "adapt, Gauss s=2, r^1.5", function(h)
   return dm.integrator(kep, {method = "gauss", stages = 2, h = h,
     adapt = {monitor = function(q) return dm.sqrt(q.x^2 + q.y^2)^1.5 end}}) end,
   {0.04, 0.028, 0.02, 0.014, 0.01}, {t = T, every = 1e9})
-sweep("GSL rk8pd as gsl:rk8pd, tol", function(tol)
+sweep("GSL rk8pd (gsl:rk8pd), tol", "GSL rk8pd", function(tol)
   return dm.integrator(kep, {method = "gsl:rk8pd", adaptive = true, epsabs = tol, epsrel = tol,
                              h = 2 * math.pi}) end,
   {1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14}, {t = T, every = 1e9})
-sweep("fixed steps, composition order 8", function(h)
+sweep("fixed steps, composition order 8, h", "fixed step, composition order 8", function(h)
   return dm.integrator(kep, {method = "composition", order = 8, h = h}) end,
   {0.02, 0.014, 0.01, 0.007}, {t = T, every = 1e9})
 
@@ -111,10 +111,12 @@ dm.plot{
   {{r, hk, with = "points pt 7 ps 0.5", title = "physical steps"},
    {function(x) return x, 0.02 * x^1.5 end, range = {0.09, 2}, title = "0.02 r^1.5", with = "lines lw 2"},
    title = "(b) step against distance", xlabel = "r", ylabel = "physical step", logscale = "xy",
+   xrange = {0.05, 3}, yrange = {3e-4, 0.1},
    grid = true, key = "top left"},
   {curves[1], curves[2], curves[3], curves[4],
    title = string.format("(c) error after %d periods", periods), xlabel = "CPU seconds",
-   ylabel = "|(q, p) - exact|", logscale = "xy", grid = true, key = "bottom left"},
+   ylabel = "|(q, p) - exact|", logscale = "xy", grid = true, key = "bottom right",
+   yrange = {1e-13, 10}},
   {{ta, da, with = "linespoints pt 7 ps 0.5", title = "adapt, composition order 8 (16 steps/period)"},
    {tg, dg, with = "lines lw 2", title = "GSL rk8pd, tol 1e-11"},
    title = "(d) energy error, once per period", xlabel = "t", ylabel = "|H - H0|", logscale = "y", grid = true,

@@ -2,7 +2,7 @@
 -- §5): the sine-Gordon equation u_tt = u_xx - sin u on a space-time grid
 -- (bilinear elements, one-point rule), a kink and an antikink colliding
 -- (the exact Perring-Skyrme solution u = 4 atan(sinh(g v t)/(v cosh(g x)))).
---   sine_gordon.png   (a) u(x, t) at successive times (shifted upwards by t):
+--   sine_gordon.png   (a) u(x, t) at successive times (shifted upwards by 0.8 (t - t0)):
 --                     the two pass through each other; (b) the error at the
 --                     end against the exact solution, dx = 0.1 and 0.05 (order
 --                     2); (c) the energy error over the run; the title gives the
@@ -34,7 +34,8 @@ local W, tr, U = solve(600, 30)
 local x = W:x()
 print(string.format("%d nodes, dt = %g, %d steps; kink energy 8 g = %.6f each", #x, 0.05, T / 0.05, 8 * g))
 
--- (a) snapshots, shifted by t
+-- (a) snapshots every 3 time units, shifted by 0.8 (t - t0) (the run's clock
+-- starts at 0)
 local snaps = {}
 for r = 1, U:rows(), 2 do
   local t = tr:column("t")[r]
@@ -42,9 +43,9 @@ for r = 1, U:rows(), 2 do
   for i = 1, #x do y[i] = U[r][i] + 0.8 * t end
   snaps[#snaps + 1] = {x, y, with = "lines lw 1.5 lc rgb '#3060a0'"}
 end
-snaps.title = "(a) u(x, t) + 0.8 t: kink and antikink collide"
+snaps.title = "(a) u(x, t) + 0.8 (t - t0): kink and antikink collide"
 snaps.xlabel = "x"
-snaps.ylabel = "u + 0.8 t"
+snaps.ylabel = "u + 0.8 (t - t0)"
 snaps.key = false
 snaps.xrange = {-20, 20}
 
