@@ -1,5 +1,5 @@
-/* l_ensemble.c -- dm.ensemble{...}, dm.mpi.*, dm.rng: the Lua face of
- * core/ensemble.h and core/mpi.h.
+/* l_ensemble.c -- dm.ensemble{...}: the Lua face of core/ensemble.h
+ * (dm.rng: l_rng.c; dm.mpi: l_mpi.c).
  *
  * dm.ensemble reads its options, then hands everything to the core driver
  * (dm_ensemble_run), which runs the members on its worker threads (and MPI
@@ -20,114 +20,15 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
+#include "lua/l_ensemble.h"
 #include "lua/l_integ.h"
 #include "lua/l_lie_sys.h"
 #include "core/ensemble.h"
 #include "core/interrupt.h"
 #include "core/mpi.h"
 #include "core/trajectory_h5.h"
-
-#define RNG_MT "dmech.rng"
-
-/* The status of dm_mpi_start() at load time (a build without MPI started by
- * mpirun with several processes refuses to run ensembles). */
-static int mpi_status = DM_OK;
-static char mpi_message[DM_ERRMSG_MAX];
-
-/* {======================================================================
- * dm.rng: GSL's Mersenne twister, seeded
- * ======================================================================= */
-
-typedef struct lrng {
-  gsl_rng *r;
-} lrng;
-
-static gsl_rng *check_rng(lua_State *L, int idx)
-{
-  lrng *u = luaL_checkudata(L, idx, RNG_MT);
-  if (u->r == NULL)
-    luaL_argerror(L, idx, "random generator is closed");
-  return u->r;
-}
-
-static lrng *push_rng(lua_State *L, unsigned long seed)
-{
-  lrng *u = lua_newuserdatauv(L, sizeof *u, 0);
-  u->r = NULL;
-  luaL_setmetatable(L, RNG_MT);
-  if ((u->r = gsl_rng_alloc(gsl_rng_mt19937)) == NULL)
-    luaL_error(L, "dm.rng: out of memory");
-  gsl_rng_set(u->r, seed);
-  return u;
-}
-
-static int rng_gc(lua_State *L)
-{
-  lrng *u = luaL_checkudata(L, 1, RNG_MT);
-  gsl_rng_free(u->r);
-  u->r = NULL;
-  return 0;
-}
-
-static int rng_tostring(lua_State *L)
-{
-  lrng *u = luaL_checkudata(L, 1, RNG_MT);
-  lua_pushstring(L, u->r != NULL ? "<rng mt19937>" : "<rng (closed)>");
-  return 1;
-}
-
-static lua_Integer check_seed(lua_State *L, int idx)
-{
-  lua_Integer s = luaL_checkinteger(L, idx);
-  if (s < 0 || s > 0xffffffffLL)
-    luaL_argerror(L, idx, "seed in 0 .. 2^32-1 expected");
-  return s;
-}
-
-/* dm.rng(seed) */
-static int l_rng(lua_State *L)
-{
-  push_rng(L, (unsigned long)check_seed(L, 1));
-  return 1;
-}
-
-/* rng:uniform([a, b]) in [a, b), default [0, 1) */
-static int rng_uniform(lua_State *L)
-{
-  gsl_rng *r = check_rng(L, 1);
-  double a = luaL_optnumber(L, 2, 0.0), b = luaL_optnumber(L, 3, 1.0);
-  if (!(a < b) || !isfinite(a) || !isfinite(b))
-    return luaL_error(L, "rng:uniform: need finite a < b, got %f, %f", a, b);
-  lua_pushnumber(L, a + (b - a) * gsl_rng_uniform(r));
-  return 1;
-}
-
-/* rng:gaussian([sigma[, mean]]) */
-static int rng_gaussian(lua_State *L)
-{
-  gsl_rng *r = check_rng(L, 1);
-  double sigma = luaL_optnumber(L, 2, 1.0), mean = luaL_optnumber(L, 3, 0.0);
-  if (!(sigma >= 0) || !isfinite(sigma) || !isfinite(mean))
-    return luaL_error(L, "rng:gaussian: need a finite sigma >= 0 and mean");
-  lua_pushnumber(L, mean + gsl_ran_gaussian_ziggurat(r, sigma));
-  return 1;
-}
-
-/* rng:integer(n) in 1 .. n */
-static int rng_integer(lua_State *L)
-{
-  gsl_rng *r = check_rng(L, 1);
-  lua_Integer n = luaL_checkinteger(L, 2);
-  if (n < 1 || n > 0xffffffffLL)
-    return luaL_argerror(L, 2, "n in 1 .. 2^32-1 expected");
-  lua_pushinteger(L, 1 + (lua_Integer)gsl_rng_uniform_int(r, (unsigned long)n));
-  return 1;
-}
-
-/* }====================================================================== */
 
 /* {======================================================================
  * the call's state and the trampolines
@@ -185,7 +86,7 @@ static int start_body(lua_State *L)
   size_t i;
   /* the same generator stream for every rank count: re-seeded per member */
   if (lua_type(L, S(A_RNG)) == LUA_TUSERDATA)
-    gsl_rng_set(check_rng(L, S(A_RNG)), dm_ens_seed(c->seed, c->k));
+    gsl_rng_set(dm_lua_checkrng(L, S(A_RNG)), dm_ens_seed(c->seed, c->k));
   if (c->have_params) {
     member_value(L, c, A_PARAMS, c->params_fn, "params");
     if (lua_type(L, -1) != LUA_TTABLE)
@@ -560,8 +461,7 @@ static int l_ensemble(lua_State *L)
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
   lua_settop(L, A_TOP);
-  if (mpi_status != DM_OK)
-    return luaL_error(L, "dm.ensemble: %s", mpi_message);
+  dm_lua_mpi_check(L, "dm.ensemble");
   check_keys(L, A_OPTS, ens_keys, "option");
   if (lua_getfield(L, A_OPTS, "integrator") == LUA_TNIL)
     return luaL_error(L, "dm.ensemble: integrator = (a dm.integrator) is required");
@@ -654,7 +554,7 @@ static int l_ensemble(lua_State *L)
   c->seed = (unsigned long)seed;
   c->nuser = nuser;
   if (c->states_fn || c->params_fn)
-    push_rng(L, c->seed);
+    dm_lua_pushrng(L, c->seed);
   else
     lua_pushnil(L);
   lua_replace(L, A_RNG);
@@ -719,121 +619,17 @@ static int l_ensemble(lua_State *L)
 
 /* }====================================================================== */
 
-/* {======================================================================
- * dm.mpi
- * ======================================================================= */
-
-static int mpi_check(lua_State *L, const char *what)
-{
-  if (mpi_status != DM_OK)
-    return luaL_error(L, "%s: %s", what, mpi_message);
-  return 0;
-}
-
-static int l_mpi_rank(lua_State *L)
-{
-  mpi_check(L, "dm.mpi.rank");
-  lua_pushinteger(L, dm_mpi_rank());
-  return 1;
-}
-
-static int l_mpi_size(lua_State *L)
-{
-  mpi_check(L, "dm.mpi.size");
-  lua_pushinteger(L, dm_mpi_size());
-  return 1;
-}
-
-static int l_mpi_barrier(lua_State *L)
-{
-  dm_err e;
-  int st;
-  mpi_check(L, "dm.mpi.barrier");
-  if ((st = dm_mpi_barrier(&e)) != DM_OK)
-    return dm_lua_fail(L, "dm.mpi.barrier", st, &e);
-  return 0;
-}
-
-/* Monotonic wall-clock seconds (MPI_Wtime's meaning, with or without MPI):
- * os.clock counts the CPU time of every thread. */
-static int l_mpi_wtime(lua_State *L)
-{
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  lua_pushnumber(L, (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec);
-  return 1;
-}
-
-static int l_mpi_info(lua_State *L)
-{
-  lua_createtable(L, 0, 6);
-  lua_pushboolean(L, dm_mpi_built());
-  lua_setfield(L, -2, "built");
-  lua_pushboolean(L, dm_mpi_active());
-  lua_setfield(L, -2, "active");
-  lua_pushstring(L, dm_mpi_library());
-  lua_setfield(L, -2, "library");
-  lua_pushstring(L, dm_h5_mode());
-  lua_setfield(L, -2, "hdf5");
-  lua_pushstring(L, dm_h5_version());
-  lua_setfield(L, -2, "hdf5_version");
-  lua_pushinteger(L, dm_mpi_local_size());
-  lua_setfield(L, -2, "local_size");
-  return 1;
-}
-
-/* }====================================================================== */
-
 static const dm_reg ens_funcs[] = {
   {"ensemble", l_ensemble,
    "dm.ensemble{integrator=, members=, states=, params=, run={t=|steps=, every=}, reduce=, threads=, seed=, output=} -> table[, message]",
    "Run many members (states = a list or function(k, rng), params likewise) on all cores and MPI ranks; reduce = built-in reducers {\"final\", \"energy_error\", \"min_distance\", \"megno\", \"fli\", \"lyapunov\"} or function(traj, k) with columns = {names}; returns a table with one row per member (t, the reduced columns, status) that saves to .csv or .h5 (output = \"f.h5\" writes it collectively)."},
-  {"rng", l_rng, "dm.rng(seed) -> rng",
-   "A GSL Mersenne-twister random generator seeded with seed (0 .. 2^32-1); dm.ensemble gives its generators one per member, seeded from its seed and the member's number."},
   {NULL, NULL, NULL, NULL}
-};
-
-static const dm_reg mpi_funcs[] = {
-  {"rank", l_mpi_rank, "dm.mpi.rank() -> integer",
-   "This process's MPI rank (0 without mpirun)."},
-  {"size", l_mpi_size, "dm.mpi.size() -> integer",
-   "The number of MPI ranks running the script (1 without mpirun)."},
-  {"barrier", l_mpi_barrier, "dm.mpi.barrier()",
-   "Wait until every rank has reached this call (no-op without mpirun)."},
-  {"wtime", l_mpi_wtime, "dm.mpi.wtime() -> seconds",
-   "Wall-clock seconds from an arbitrary origin (monotonic), for timing runs; os.clock counts the CPU time of all threads."},
-  {"info", l_mpi_info, "dm.mpi.info() -> {built=, active=, library=, hdf5=, ...}",
-   "How this dmech was built and started: MPI support and library, the HDF5 version and whether it writes in parallel."},
-  {NULL, NULL, NULL, NULL}
-};
-
-static const dm_reg rng_methods[] = {
-  {"uniform", rng_uniform, "rng:uniform([a, b]) -> number",
-   "A uniform deviate in [a, b) (default [0, 1))."},
-  {"gaussian", rng_gaussian, "rng:gaussian([sigma[, mean]]) -> number",
-   "A normal deviate with standard deviation sigma (1) and mean (0)."},
-  {"integer", rng_integer, "rng:integer(n) -> integer",
-   "A uniform integer in 1 .. n."},
-  {NULL, NULL, NULL, NULL}
-};
-
-static const luaL_Reg rng_meta[] = {
-  {"__gc", rng_gc},
-  {"__close", rng_gc},
-  {"__tostring", rng_tostring},
-  {NULL, NULL}
 };
 
 void dm_open_ensemble(lua_State *L)
 {
-  dm_err e;
   dm_gsl_init();
-  if ((mpi_status = dm_mpi_start(&e)) != DM_OK)
-    snprintf(mpi_message, sizeof mpi_message, "%s", e.msg);
-  dm_newclass(L, RNG_MT, "rng", rng_methods, rng_meta);
-  lua_pop(L, 1);
+  dm_open_mpi(L);
+  dm_open_rng(L);
   dm_register(L, "dm.", ens_funcs);
-  lua_newtable(L);
-  dm_register(L, "dm.mpi.", mpi_funcs);
-  lua_setfield(L, -2, "mpi");
 }
