@@ -97,6 +97,20 @@ int dm_lua_issymvec(lua_State *L, int idx)
   return is;
 }
 
+/* Add the elements of the data table at data to b, separated by ", ". */
+static void add_elements(lua_State *L, luaL_Buffer *b, int data)
+{
+  lua_Integer n = (lua_Integer)lua_rawlen(L, data);
+  for (lua_Integer i = 1; i <= n; i++) {
+    lua_rawgeti(L, data, i);
+    dm_tolstring(L, -1, NULL);
+    lua_remove(L, -2);
+    luaL_addvalue(b);
+    if (i < n)
+      luaL_addstring(b, ", ");
+  }
+}
+
 static int symvec_index(lua_State *L)
 {
   push_symvec_data(L, 1);
@@ -110,16 +124,8 @@ static int symvec_index(lua_State *L)
   const char *label = symvec_label(L, 1);
   if (lua_type(L, 2) == LUA_TSTRING) {
     luaL_Buffer b;
-    lua_Integer n = (lua_Integer)lua_rawlen(L, data);
     luaL_buffinit(L, &b);
-    for (lua_Integer i = 1; i <= n; i++) {
-      lua_rawgeti(L, data, i);
-      dm_tolstring(L, -1, NULL);
-      lua_remove(L, -2);
-      luaL_addvalue(&b);
-      if (i < n)
-        luaL_addstring(&b, ", ");
-    }
+    add_elements(L, &b, data);
     luaL_pushresult(&b);
     return luaL_error(L, "no element '%s' in %s (elements: %s)",
                       lua_tostring(L, 2), label, lua_tostring(L, -1));
@@ -159,18 +165,28 @@ static int symvec_tostring(lua_State *L)
   luaL_buffinit(L, &b);
   luaL_addstring(&b, symvec_label(L, 1));
   luaL_addstring(&b, "{");
-  lua_Integer n = (lua_Integer)lua_rawlen(L, data);
-  for (lua_Integer i = 1; i <= n; i++) {
-    lua_rawgeti(L, data, i);
-    dm_tolstring(L, -1, NULL);
-    lua_remove(L, -2);
-    luaL_addvalue(&b);
-    if (i < n)
-      luaL_addstring(&b, ", ");
-  }
+  add_elements(L, &b, data);
   luaL_addstring(&b, "}");
   luaL_pushresult(&b);
   return 1;
+}
+
+/* Replace the data table at the top by a new proxy of it labelled label. */
+static void data_to_proxy(lua_State *L, const char *label)
+{
+  lua_newtable(L);                                  /* proxy */
+  luaL_setmetatable(L, SYMVEC_MT);
+  lua_getfield(L, LUA_REGISTRYINDEX, SYMVEC_DATA_KEY);
+  lua_pushvalue(L, -2);
+  lua_pushvalue(L, -4);
+  lua_rawset(L, -3);
+  lua_pop(L, 1);
+  lua_getfield(L, LUA_REGISTRYINDEX, LABELS_KEY);
+  lua_pushvalue(L, -2);
+  lua_pushstring(L, label);
+  lua_rawset(L, -3);
+  lua_pop(L, 1);
+  lua_remove(L, -2);                                /* leave the proxy */
 }
 
 void dm_lua_pushsymvec(lua_State *L, const char *label, size_t n,
@@ -190,19 +206,7 @@ void dm_lua_pushsymvec(lua_State *L, const char *label, size_t n,
     lua_rawseti(L, -3, (lua_Integer)i + 1);
     lua_setfield(L, -2, elems[i]);
   }
-  lua_newtable(L);                                  /* proxy */
-  luaL_setmetatable(L, SYMVEC_MT);
-  lua_getfield(L, LUA_REGISTRYINDEX, SYMVEC_DATA_KEY);
-  lua_pushvalue(L, -2);
-  lua_pushvalue(L, -4);
-  lua_rawset(L, -3);
-  lua_pop(L, 1);
-  lua_getfield(L, LUA_REGISTRYINDEX, LABELS_KEY);
-  lua_pushvalue(L, -2);
-  lua_pushstring(L, label);
-  lua_rawset(L, -3);
-  lua_pop(L, 1);
-  lua_remove(L, -2);                                /* leave the proxy */
+  data_to_proxy(L, label);
 }
 
 void dm_lua_symvec_group(lua_State *L, int idx, const char *name, size_t first,
@@ -216,20 +220,9 @@ void dm_lua_symvec_group(lua_State *L, int idx, const char *name, size_t first,
     lua_rawgeti(L, pdata, (lua_Integer)(first + i) + 1);
     lua_rawseti(L, -2, (lua_Integer)i + 1);
   }
-  lua_newtable(L);                                  /* proxy */
-  luaL_setmetatable(L, SYMVEC_MT);
-  lua_getfield(L, LUA_REGISTRYINDEX, SYMVEC_DATA_KEY);
-  lua_pushvalue(L, -2);
-  lua_pushvalue(L, -4);
-  lua_rawset(L, -3);
-  lua_pop(L, 1);
-  lua_getfield(L, LUA_REGISTRYINDEX, LABELS_KEY);
-  lua_pushvalue(L, -2);
-  lua_pushstring(L, label);
-  lua_rawset(L, -3);
-  lua_pop(L, 1);
+  data_to_proxy(L, label);
   lua_setfield(L, pdata, name);                     /* parent.name = proxy */
-  lua_pop(L, 2);
+  lua_pop(L, 1);
 }
 
 /* A format must contain exactly one %s and no other conversion. */
