@@ -72,6 +72,9 @@ void dm_lua_open_conn_point(lua_State *L);
 /* readers shared by the connection bindings (l_conn_args.c) */
 /* n numbers at idx: a vec, a list, or (n = 1) a number; raises naming what. */
 size_t dm_lua_conn_readnums(lua_State *L, int idx, const char *what, double *x, size_t n);
+/* An element of the Lie algebra (dim numbers: a vec, or a number when
+ * dim = 1) at idx; raises as dm_checkvector does. */
+void dm_lua_conn_readalgebra(lua_State *L, int idx, size_t dim, double *xi);
 /* Options of a transport: {substeps = n, tol = t} at idx (0: none). */
 void dm_lua_readtopts(lua_State *L, int idx, const char *fname, dm_conn_topts *o);
 /* Raise "<fname>: unknown option 'k' (options: a, b)" for keys not in known. */

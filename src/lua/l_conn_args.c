@@ -85,6 +85,19 @@ size_t dm_lua_conn_readnums(lua_State *L, int idx, const char *what, double *x, 
   return n;
 }
 
+void dm_lua_conn_readalgebra(lua_State *L, int idx, size_t dim, double *xi)
+{
+  gsl_vector *v;
+  size_t k;
+  if (dim == 1 && lua_type(L, idx) == LUA_TNUMBER) {
+    xi[0] = lua_tonumber(L, idx);
+    return;
+  }
+  v = dm_checkvector(L, idx, dim);
+  for (k = 0; k < dim; k++)
+    xi[k] = gsl_vector_get(v, k);
+}
+
 void dm_lua_readshape(lua_State *L, const dm_conn_bundle *B, int idx, const char *what, double *x)
 {
   dm_err e;

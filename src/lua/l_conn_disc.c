@@ -367,13 +367,7 @@ static int l_discrete_mechanical(lua_State *L)
     return dm_lua_fail(L, "dm.discrete_mechanical_connection", e.status, &e);
   lua_getfield(L, 1, "mu");
   if (!lua_isnil(L, -1)) {
-    if (lua_type(L, -1) == LUA_TNUMBER && B->G->dim == 1) {
-      mu[0] = lua_tonumber(L, -1);
-    } else {
-      gsl_vector *v = dm_checkvector(L, lua_gettop(L), B->G->dim);
-      for (k = 0; k < B->G->dim; k++)
-        mu[k] = gsl_vector_get(v, k);
-    }
+    dm_lua_conn_readalgebra(L, lua_gettop(L), B->G->dim, mu);
     if (dm_conn_dc_set_mu(d->D, mu, &e) != DM_OK)
       return dm_lua_fail(L, "dm.discrete_mechanical_connection", e.status, &e);
   }
@@ -401,14 +395,26 @@ static int push_g(lua_State *L, int bidx, const double *g)
   return 1;
 }
 
-static int d_call(lua_State *L)
+/* The discrete connection at 1 and the pair (q0, q1) at 2, 3 named
+ * "<what>: q0", "<what>: q1"; *b the index of the bundle pushed above. */
+static dm_ldconn *pair_args(lua_State *L, const char *what, int *b, double *q0, double *q1)
 {
   dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1, 3);
+  char w[64];
+  *b = bundle_idx(L, 1, 3);
+  snprintf(w, sizeof w, "%s: q0", what);
+  dm_lua_readpoint(L, *b, 2, w, q0);
+  snprintf(w, sizeof w, "%s: q1", what);
+  dm_lua_readpoint(L, *b, 3, w, q1);
+  return d;
+}
+
+static int d_call(lua_State *L)
+{
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], g[DM_LIE_NQ_MAX];
+  int b;
+  dm_ldconn *d = pair_args(L, "A_d", &b, q0, q1);
   dm_err e;
-  dm_lua_readpoint(L, b, 2, "A_d: q0", q0);
-  dm_lua_readpoint(L, b, 3, "A_d: q1", q1);
   if (dm_conn_dc_eval(d->D, q0, q1, g, &e) != DM_OK)
     return dm_lua_fail(L, "A_d", e.status, &e);
   return push_g(L, b, g);
@@ -430,13 +436,11 @@ static int d_at(lua_State *L)
 
 static int hor_ver(lua_State *L, int ver)
 {
-  dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1, 3);
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], r[DM_CONN_NQ_MAX];
+  int b;
+  dm_ldconn *d = pair_args(L, ver ? "ver" : "hor", &b, q0, q1);
   dm_err e;
   int st;
-  dm_lua_readpoint(L, b, 2, ver ? "ver: q0" : "hor: q0", q0);
-  dm_lua_readpoint(L, b, 3, ver ? "ver: q1" : "hor: q1", q1);
   st = ver ? dm_conn_dc_ver(d->D, q0, q1, r, &e) : dm_conn_dc_hor(d->D, q0, q1, r, &e);
   if (st != DM_OK)
     return dm_lua_fail(L, ver ? "ver" : "hor", st, &e);
@@ -549,14 +553,12 @@ static int d_compose(lua_State *L)
 
 static int d_reduce(lua_State *L)
 {
-  dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1, 3);
-  const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], x0[DM_CONN_NX_MAX], x1[DM_CONN_NX_MAX],
          z[DM_LIE_NQ_MAX];
+  int b;
+  dm_ldconn *d = pair_args(L, "reduce", &b, q0, q1);
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   dm_err e;
-  dm_lua_readpoint(L, b, 2, "reduce: q0", q0);
-  dm_lua_readpoint(L, b, 3, "reduce: q1", q1);
   if (dm_conn_dc_reduce(d->D, q0, q1, x0, x1, z, &e) != DM_OK)
     return dm_lua_fail(L, "reduce", e.status, &e);
   dm_pushvec_copy(L, x0, B->nx);
@@ -586,13 +588,11 @@ static int d_unreduce(lua_State *L)
 
 static int d_split(lua_State *L)
 {
-  dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1, 3);
-  const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], x[DM_CONN_NX_MAX], g[DM_LIE_NQ_MAX];
+  int b;
+  dm_ldconn *d = pair_args(L, "split", &b, q0, q1);
+  const dm_conn_bundle *B = dm_lua_checkbundle(L, b)->B;
   dm_err e;
-  dm_lua_readpoint(L, b, 2, "split: q0", q0);
-  dm_lua_readpoint(L, b, 3, "split: q1", q1);
   if (dm_conn_dc_eval(d->D, q0, q1, g, &e) != DM_OK)
     return dm_lua_fail(L, "split", e.status, &e);
   dm_conn_proj(B, q0, x);
@@ -617,13 +617,7 @@ static int d_limit(lua_State *L)
   v = dm_checkvector(L, 3, B->nx);
   for (k = 0; k < B->nx; k++)
     xd[k] = gsl_vector_get(v, k);
-  if (B->G->dim == 1 && lua_type(L, 4) == LUA_TNUMBER) {
-    xi[0] = lua_tonumber(L, 4);
-  } else {
-    v = dm_checkvector(L, 4, B->G->dim);
-    for (k = 0; k < B->G->dim; k++)
-      xi[k] = gsl_vector_get(v, k);
-  }
+  dm_lua_conn_readalgebra(L, 4, B->G->dim, xi);
   if (dm_conn_dc_limit(d->D, q, xd, xi, eps, out, &e) != DM_OK)
     return dm_lua_fail(L, "limit", e.status, &e);
   dm_pushvec_copy(L, out, B->G->dim);
@@ -649,12 +643,10 @@ static int d_phase(lua_State *L)
 
 static int d_momentum(lua_State *L)
 {
-  dm_ldconn *d = checkld(L, 1);
-  int b = bundle_idx(L, 1, 3);
   double q0[DM_CONN_NQ_MAX], q1[DM_CONN_NQ_MAX], J[DM_LIE_DIM_MAX];
+  int b;
+  dm_ldconn *d = pair_args(L, "momentum", &b, q0, q1);
   dm_err e;
-  dm_lua_readpoint(L, b, 2, "momentum: q0", q0);
-  dm_lua_readpoint(L, b, 3, "momentum: q1", q1);
   if (dm_conn_dc_momentum(d->D, q0, q1, J, &e) != DM_OK)
     return dm_lua_fail(L, "momentum", e.status, &e);
   dm_pushvec_copy(L, J, dm_conn_dc_bundle(d->D)->G->dim);
@@ -664,16 +656,9 @@ static int d_momentum(lua_State *L)
 static int d_set_mu(lua_State *L)
 {
   dm_ldconn *d = checkld(L, 1);
-  size_t dim = dm_conn_dc_bundle(d->D)->G->dim, k;
   double mu[DM_LIE_DIM_MAX];
   dm_err e;
-  if (dim == 1 && lua_type(L, 2) == LUA_TNUMBER) {
-    mu[0] = lua_tonumber(L, 2);
-  } else {
-    gsl_vector *v = dm_checkvector(L, 2, dim);
-    for (k = 0; k < dim; k++)
-      mu[k] = gsl_vector_get(v, k);
-  }
+  dm_lua_conn_readalgebra(L, 2, dm_conn_dc_bundle(d->D)->G->dim, mu);
   if (dm_conn_dc_set_mu(d->D, mu, &e) != DM_OK)
     return dm_lua_fail(L, "set_mu", e.status, &e);
   lua_settop(L, 1);
