@@ -704,6 +704,15 @@ static int l_system(lua_State *L)
   ls->sys.refresh = dm_lagrangian_refresh;     /* its separable mass follows the parameters */
   if (dm_lagrangian_stats_get(&ls->sys, &st) == DM_OK)
     ls->native = st.native_all;
+  if (mode == DM_NATIVE_WAIT && !ls->native) {     /* asked to wait for it: say why not */
+    dm_lagrangian_native ns;
+    dm_err_clear(&e);
+    if (dm_lagrangian_native_state(&ls->sys, &ns, &e) == DM_OK && ns.native == 0 && e.msg[0]) {
+      lua_pushfstring(L, "dm.system: '%s' runs on the tape (%s)", name, e.msg);
+      dm_lua_warning(L, lua_tostring(L, -1));
+      lua_pop(L, 1);
+    }
+  }
   detect_cyclic(L, ls);
   lua_pushvalue(L, 2);
   dm_lua_system_finish(L, ls, NULL);
@@ -744,7 +753,7 @@ static const dm_reg system_funcs[] = {
    "compiled; params given as a map are ordered by name.  native (default dm.config.native): "
    "\"auto\" runs at once on the tape while native code compiles in the background and "
    "takes over between steps (sys.compiling, sys.native, sys.native_error); \"wait\" "
-   "compiles first (Ctrl-C: the tape); \"always\" compiles first and fails without a "
+   "compiles first (Ctrl-C, no compiler: the tape, with a warning); \"always\" compiles first and fails without a "
    "compiler; \"never\" keeps the tape.  coords may hold arrays dm.coords(name, n): "
    "coordinates name[1] .. name[n], q.name[i] in L."},
   {"coords", l_coords, "dm.coords(name, n) -> coordinate array",
