@@ -338,6 +338,26 @@ static int publish(const char *tmp, const char *path, dm_err *e)
 
 /* The file creation list: link and attribute creation order tracked on the
  * root group, so columns and metadata come back in their order. */
+/* File access for the temporary file being written: without HDF5's file
+ * lock.  Nobody else knows the file's name before it is renamed into
+ * place, so the lock protects nothing; but flock locks belong to the open
+ * file, so a child forked by another thread while the file is open (a
+ * compiler started in the background) keeps a copy of the descriptor and
+ * with it the exclusive lock after H5Fclose, and reading the published
+ * file then fails ("unable to lock file, errno = 11") until the child has
+ * closed it.  Readers keep their shared lock: it only conflicts with an
+ * exclusive one. */
+static hid_t unlocked_fapl(void)
+{
+  hid_t p = H5Pcreate(H5P_FILE_ACCESS);
+#if (H5_VERS_MAJOR == 1 && H5_VERS_MINOR == 10 && H5_VERS_RELEASE >= 7) \
+    || H5_VERSION_GE(1, 12, 1)
+  if (p >= 0)
+    H5Pset_file_locking(p, 0, 1);
+#endif
+  return p;
+}
+
 static hid_t ordered_fcpl(void)
 {
   hid_t p = H5Pcreate(H5P_FILE_CREATE);
@@ -351,7 +371,7 @@ static hid_t ordered_fcpl(void)
 int dm_traj_save_h5(const dm_traj *tr, const char *path, dm_err *e)
 {
   dm_outfile o;                 /* core/outfile.h: what may be replaced */
-  hid_t fcpl, f;
+  hid_t fcpl, fapl, f;
   int st;
   if (path == NULL || path[0] == '\0')
     return dm_err_set(e, DM_EINVAL, "save: empty file name");
@@ -361,13 +381,16 @@ int dm_traj_save_h5(const dm_traj *tr, const char *path, dm_err *e)
     return st;
   lock();
   fcpl = ordered_fcpl();
-  f = H5Fcreate(o.tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
+  fapl = unlocked_fapl();
+  f = H5Fcreate(o.tmp, H5F_ACC_TRUNC, fcpl, fapl >= 0 ? fapl : H5P_DEFAULT);
   if (f < 0)
     st = h5_fail(e, DM_EIO, path, "cannot create the HDF5 file");
   else
     st = write_file(f, tr, 0, 1, H5P_DEFAULT, path, e);
   if (f >= 0 && H5Fclose(f) < 0 && st == DM_OK)
     st = h5_fail(e, DM_EIO, path, "cannot close the HDF5 file");
+  if (fapl >= 0)
+    H5Pclose(fapl);
   if (fcpl >= 0)
     H5Pclose(fcpl);
   unlock();
@@ -806,7 +829,7 @@ static int save_parallel(const dm_traj *tr, const char *path, dm_err *e)
   }
   lock();
   fcpl = ordered_fcpl();
-  fapl = H5Pcreate(H5P_FILE_ACCESS);
+  fapl = unlocked_fapl();
   dxpl = H5Pcreate(H5P_DATASET_XFER);
   if (fapl < 0 || dxpl < 0 || H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL) < 0
       || H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0)
