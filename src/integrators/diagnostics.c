@@ -39,6 +39,10 @@ int dm_integrator_jacobian(dm_integrator *I, double h, const double *q0,
   if (I->m > 0)
     return dm_err_set(e, DM_EUNSUP, "the step Jacobian in the containing space is not defined for "
                       "constrained systems");
+  if (I->type->manifold_defect != NULL)
+    return dm_err_set(e, DM_EUNSUP, "the step Jacobian in coordinates is not defined for "
+                      "method '%s': its states live on a manifold (%s)", I->name,
+                      I->sys->space != NULL ? I->sys->space : "not all of the coordinates");
   if (I->nq != I->n)
     return dm_err_set(e, DM_EUNSUP, "the step Jacobian in coordinates is not defined for a "
                       "configuration stored in %zu numbers with %zu velocities (a system on a "
@@ -52,8 +56,11 @@ int dm_integrator_symplecticity_defect(dm_integrator *I, double h, const double 
                                        const double *p0, double *defect, dm_err *e)
 {
   size_t n = I->n, N = 2 * n, i, j, k;
-  double *D = malloc(2 * N * N * sizeof(double)), *JD, worst = 0.0;
+  double *D, *JD, worst = 0.0;
   int st;
+  if (I->type->manifold_defect != NULL)
+    return I->type->manifold_defect(I, h, q0, p0, defect, e);
+  D = malloc(2 * N * N * sizeof(double));
   if (D == NULL)
     return dm_err_set(e, DM_ENOMEM, "symplecticity defect: out of memory");
   JD = D + N * N;
@@ -169,11 +176,16 @@ int dm_integrator_order_estimate(const dm_system *sys, const char *method,
     memcpy(pr, pref, n * sizeof(double));
   } else {
     /* reference: Gauss 6 (order 12), or Lobatto 6 (order 10) with
-     * constraints, at an eighth of the smallest step */
+     * constraints, at an eighth of the smallest step; for systems of a
+     * kind without these (on a sphere) the method itself at a 64th */
     dm_integ_opts ro;
+    const char *ref = sys->m ? "lobatto" : "gauss";
     dm_integ_opts_init(&ro);
     ro.stages = 6;
-    st = integrate_to(sys, sys->m ? "lobatto" : "gauss", &ro, q0, p0, T, hmin / 8, qr, pr, e);
+    if (dm_integrator_find(sys->kind, ref, NULL) != NULL)
+      st = integrate_to(sys, ref, &ro, q0, p0, T, hmin / 8, qr, pr, e);
+    else
+      st = integrate_to(sys, method, opts, q0, p0, T, hmin / 64, qr, pr, e);
   }
   for (i = 0; i < k && st == DM_OK; i++) {
     double s2 = 0.0;

@@ -188,6 +188,12 @@ typedef struct dm_integrator_type {
                dm_err *e);
   int (*step_until)(dm_integrator *I, double h, double t_end, const double *q0,
                     const double *p0, double *q1, double *p1, int *reached, dm_err *e);
+  /* States on a submanifold of the coordinates (a sphere in R^(n+1)):
+   * the symplecticity defect of the step map for the symplectic form
+   * there, from perturbations along the manifold; the step Jacobian in
+   * coordinates is then not defined.  NULL: the states are coordinates. */
+  int (*manifold_defect)(dm_integrator *I, double h, const double *q0, const double *p0,
+                         double *defect, dm_err *e);
 } dm_integrator_type;
 
 /* Statistics of the last step and running totals. */
@@ -361,7 +367,9 @@ int dm_integrator_run(dm_integrator *I, double t0, double *q, double *p, double 
  * Not available for constrained systems (DM_EUNSUP). */
 int dm_integrator_jacobian(dm_integrator *I, double h, const double *q0,
                            const double *p0, double *DPhi, dm_err *e);
-/* max_ij |(DPhi^T J DPhi - J)_ij| with J = [[0, I], [-I, 0]]. */
+/* max_ij |(DPhi^T J DPhi - J)_ij| with J = [[0, I], [-I, 0]]; for a family
+ * whose states live on a submanifold (type->manifold_defect), the defect
+ * of the restriction of that form to it. */
 int dm_integrator_symplecticity_defect(dm_integrator *I, double h, const double *q0,
                                        const double *p0, double *defect, dm_err *e);
 /* n steps with h then n with -h from (q0, p0); *dev = max-norm distance

@@ -518,5 +518,7 @@ int dm_lie_register_integrators(dm_err *e)
     st = dm_integrator_register(&dm_lie_integ_gauss, e);
   if (st == DM_OK)
     st = dm_integrator_register(&dm_lie_integ_gsl, e);
+  if (st == DM_OK)
+    st = dm_integrator_register(&dm_sphere_integ_lgvi, e);
   return st;
 }

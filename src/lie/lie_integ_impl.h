@@ -62,5 +62,6 @@ int dm_lie_gauss_program(dm_lie_system *S, size_t s, int cayley, const dm_lie_ga
                          dm_err *e);
 
 extern const dm_integrator_type dm_lie_integ_lgvi, dm_lie_integ_gauss, dm_lie_integ_gsl;
+extern const dm_integrator_type dm_sphere_integ_lgvi;     /* sphere_lgvi.c */
 
 #endif

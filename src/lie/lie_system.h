@@ -66,6 +66,13 @@
 #include "lie/lie.h"
 
 #define DM_SYSTEM_LIE "lie"
+/* A Lagrangian system on the unit sphere S^n in R^(n+1) (coordinates: the
+ * n + 1 entries of the point x, velocities and momenta in R^(n+1) tangent
+ * at x): registered family "lgvi" (sphere_lgvi.c, Lee-Leok-McClamroch for
+ * L = (m/2)|v|^2 - U(x), explicit, order 2), with the symplecticity
+ * defect on T*S^n (integrator.h: manifold_defect).  Such a system is an
+ * ordinary Lagrangian dm_system of this kind (L traced on R^(n+1)). */
+#define DM_SYSTEM_SPHERE "sphere"
 
 typedef struct dm_lie_system dm_lie_system;
 
@@ -114,7 +121,8 @@ const char *const *dm_lie_system_xinames(const dm_lie_system *S);
 double *dm_lie_system_par(dm_lie_system *S);
 void dm_lie_system_params_changed(dm_lie_system *S);
 
-/* Register the families above with the integrator registry (idempotent). */
+/* Register the families above, and lgvi on spheres, with the integrator
+ * registry (idempotent). */
 int dm_lie_register_integrators(dm_err *e);
 
 /* {==== states and diagnostics =========================================== */
