@@ -194,6 +194,13 @@ void dm_open_reduce(lua_State *L);      /* dm.routh (l_reduce.c) */
 void dm_open_lie(lua_State *L);         /* dm.lie: Lie groups, systems on groups (l_lie*.c) */
 /* dm.system{space = G, ...}: a system on a Lie group (l_lie_system.c) */
 int dm_lua_lie_system(lua_State *L);
+/* Systems on spheres (l_lie_sphere.c): the n of the dm.lie.sphere(n) at idx
+ * (0: not a sphere); the table at 1 made an ordinary system's fields
+ * (default coords x1 .. x(n+1)); the traced system made one on S^n. */
+size_t dm_lua_tosphere(lua_State *L, int idx);
+void dm_lua_sphere_fields(lua_State *L, size_t n);
+struct dm_system;
+void dm_lua_sphere_system(lua_State *L, struct dm_system *sys, size_t n);
 /* dm.integrator(sys | obj, opts) as a C function (l_integrator.c), for
  * bindings whose objects make integrators (red:integrator). */
 int dm_lua_integrator(lua_State *L);

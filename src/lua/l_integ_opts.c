@@ -227,7 +227,7 @@ void dm_linteg_parse(lua_State *L, int idx, const char *fname, const char *const
   int given;
   idx = lua_absindex(L, idx);
   dm_integ_opts_init(opt);
-  *method = "gauss";
+  *method = sys->kind != NULL && strcmp(sys->kind, "sphere") == 0 ? "lgvi" : "gauss";
   *h = NAN;
   if (lua_getfield(L, idx, "method") != LUA_TNIL) {
     if (lua_type(L, -1) != LUA_TSTRING)

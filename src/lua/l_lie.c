@@ -730,7 +730,8 @@ static const dm_reg lie_funcs[] = {
    "The group with a name as G.name prints it (\"SO3\", \"SE3xT3\", \"R2\")."},
   {"sphere", dm_lua_lie_sphere, "dm.lie.sphere([n = 2]) -> S",
    "The unit sphere S^n in R^(n+1): S.exp, S.log, S.dist, S.tangent, S.normalize, and for S^2 "
-   "S.rotation and S.project."},
+   "S.rotation and S.project.  dm.system{space = S, L = function(x, v, p)} is a system on S^n "
+   "in the coordinates x1 .. x(n+1) of R^(n+1), stepped by method \"lgvi\" (doc/lie.md)."},
   {NULL, NULL, NULL, NULL}
 };
 

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "lua/l_lie.h"
+#include "core/system.h"
+#include "lie/lie_system.h"
 
 /* {======================================================================
  * spheres S^n
@@ -170,6 +172,64 @@ int dm_lua_lie_sphere(lua_State *L)
   lua_newtable(L);
   lua_setiuservalue(L, -2, 1);
   return 1;
+}
+
+/* {======================================================================
+ * systems on spheres: dm.system{space = dm.lie.sphere(n), ...}
+ * ======================================================================= */
+
+size_t dm_lua_tosphere(lua_State *L, int idx)
+{
+  lsphere *s = luaL_testudata(L, idx, DM_LIESPHERE_MT);
+  return s != NULL ? s->n : 0;
+}
+
+/* Replace the table at 1 by a copy without 'space', with coords
+ * x1 .. x(n+1) when it has none; constraints are refused (the sphere is
+ * the constraint). */
+void dm_lua_sphere_fields(lua_State *L, size_t n)
+{
+  luaL_checktype(L, 1, LUA_TTABLE);
+  if (lua_getfield(L, 1, "constraints") != LUA_TNIL)
+    luaL_error(L, "dm.system: a system on the sphere S^%d takes no 'constraints' (|x| = 1 is "
+               "the space's)", (int)n);
+  lua_pop(L, 1);
+  lua_newtable(L);
+  lua_pushnil(L);
+  while (lua_next(L, 1) != 0) {
+    if (lua_type(L, -2) == LUA_TSTRING && strcmp(lua_tostring(L, -2), "space") == 0) {
+      lua_pop(L, 1);
+      continue;
+    }
+    lua_pushvalue(L, -2);
+    lua_insert(L, -2);
+    lua_rawset(L, -4);
+  }
+  if (lua_getfield(L, -1, "coords") == LUA_TNIL) {
+    lua_createtable(L, (int)n + 1, 0);
+    for (size_t i = 0; i <= n; i++) {
+      lua_pushfstring(L, "x%d", (int)i + 1);
+      lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -3, "coords");
+  }
+  lua_pop(L, 1);
+  lua_replace(L, 1);
+}
+
+/* Make the traced system one on S^n (kind "sphere", its families). */
+void dm_lua_sphere_system(lua_State *L, dm_system *sys, size_t n)
+{
+  static const char *const names[] = {"S^1", "S^2", "S^3", "S^4", "S^5", "S^6", "S^7", "S^8"};
+  dm_err e;
+  int st;
+  if (sys->n != n + 1)
+    luaL_error(L, "dm.system: a system on the sphere S^%d has %d coordinates (the point in "
+               "R^%d), got %d", (int)n, (int)n + 1, (int)n + 1, (int)sys->n);
+  if ((st = dm_lie_register_integrators(&e)) != DM_OK)
+    dm_lua_fail(L, "dm.system", st, &e);
+  sys->kind = DM_SYSTEM_SPHERE;
+  sys->space = n <= 8 ? names[n - 1] : "S^n";
 }
 
 /* }====================================================================== */

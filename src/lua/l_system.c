@@ -612,11 +612,14 @@ static int l_system(lua_State *L)
   double *pvals;
   size_t n, npar, m = 0;
   int args[3], s;
+  size_t sphere = 0;                              /* n of S^n, or 0 */
   luaL_checktype(L, 1, LUA_TTABLE);
-  if (lua_getfield(L, 1, "space") != LUA_TNIL)    /* a system on a Lie group */
+  if (lua_getfield(L, 1, "space") != LUA_TNIL    /* a system on a Lie group */
+      && (sphere = dm_lua_tosphere(L, -1)) == 0)
     return dm_lua_lie_system(L);
-  lua_pop(L, 1);
   lua_settop(L, 1);
+  if (sphere > 0)
+    dm_lua_sphere_fields(L, sphere);
   check_fields(L, 1);
   const char *name = dm_optstringfield(L, 1, "name", "system");
   dm_lsystem *ls = dm_lua_system_new(L);             /* 2 */
@@ -716,6 +719,10 @@ static int l_system(lua_State *L)
   detect_cyclic(L, ls);
   lua_pushvalue(L, 2);
   dm_lua_system_finish(L, ls, NULL);
+  if (sphere > 0) {              /* after its conversions are made (as on R^(n+1)) */
+    dm_lua_sphere_system(L, &ls->sys, sphere);
+    memset(ls->cyclic, 0, ls->n);  /* the sphere couples the coordinates */
+  }
   return 1;
 }
 
@@ -755,7 +762,8 @@ static const dm_reg system_funcs[] = {
    "takes over between steps (sys.compiling, sys.native, sys.native_error); \"wait\" "
    "compiles first (Ctrl-C, no compiler: the tape, with a warning); \"always\" compiles first and fails without a "
    "compiler; \"never\" keeps the tape.  coords may hold arrays dm.coords(name, n): "
-   "coordinates name[1] .. name[n], q.name[i] in L."},
+   "coordinates name[1] .. name[n], q.name[i] in L.  space = dm.lie.SO3() (a group) or "
+   "dm.lie.sphere(n) makes a system on that space (help(dm.lie.sphere))."},
   {"coords", l_coords, "dm.coords(name, n) -> coordinate array",
    "An array of n coordinates name[1] .. name[n] for dm.system's coords, alone or in the "
    "list with names and other arrays (coords = {\"theta\", dm.coords(\"x\", 64)}): in L, "
