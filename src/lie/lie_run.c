@@ -85,6 +85,9 @@ int dm_lie_traj_group(const dm_traj *tr, dm_lie_group **G, dm_err *e)
   if (name == NULL)
     return dm_err_set(e, DM_EINVAL, "the trajectory is not of a system on a Lie group (no "
                       "'space' in its metadata)");
+  if (strncmp(name, "S^", 2) == 0)
+    return dm_err_set(e, DM_EINVAL, "the trajectory is of a system on the sphere %s, not on a "
+                      "Lie group: its points are the coordinates (traj[k].q)", name);
   if ((*G = dm_lie_group_parse(name, e)) == NULL)
     return e ? e->status : DM_EINVAL;
   if ((*G)->nq != dm_traj_ncoords(tr)) {

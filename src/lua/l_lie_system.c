@@ -186,7 +186,8 @@ int dm_lua_lie_system(lua_State *L)
   lua_getfield(L, 1, "space");                              /* 2 */
   if ((G = dm_lua_togroup(L, 2)) == NULL)
     return luaL_error(L, "dm.system: field 'space' must be a Lie group (dm.lie.SO3(), "
-                      "dm.lie.product(...)), got %s", luaL_typename(L, 2));
+                      "dm.lie.product(...)) or a sphere (dm.lie.sphere(n)), got %s",
+                      luaL_typename(L, 2));
   name = dm_optstringfield(L, 1, "name", "system");
   nq = G->nq;
   n = G->dim;

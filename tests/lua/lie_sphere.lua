@@ -56,6 +56,14 @@ T.group("a system on S^2", function()
   local tr = I:run(s0, {steps = 20})
   local md = tr:meta()
   T.ok(md.space == "S^2" and md.method == "lgvi" and md.steps == 20, "run metadata: space S^2")
+  T.error_like(function() tr:group(1) end, "traj:group: the trajectory is of a system on the "
+    .. "sphere S%^2, not on a Lie group: its points are the coordinates %(traj%[k%]%.q%)",
+    "traj:group names what a sphere's trajectory holds")
+  local f = T.tmpdir("lie_sphere") .. "/pendulum.csv"
+  T.ok(tr:save(f), "save as CSV")
+  local back = dm.load_trajectory(f)
+  T.ok(back:meta().space == "S^2" and #back == #tr, "loaded: space S^2, every sample")
+  T.near(back:column("p_x3"), tr:column("p_x3"), 0, "CSV round trip: p_x3 bit for bit")
   T.is(table.concat(tr:names(), ","), "t,x1,x2,x3,p_x1,p_x2,p_x3,v_x1,v_x2,v_x3,energy",
        "columns: no momentum of a 'cyclic' x1, x2 (the sphere couples them)")
   T.near(tr:column("p_x2")[1], m * v0[2], 1e-15, "p = m v at the start")

@@ -64,6 +64,15 @@ T.group("orders and conservation", function()
   local oc = dm.integrator(top, {method = "lie:gauss:cayley", stages = 1}):order_estimate{
     state = s0, t = 1, h = {0.1, 0.05, 0.025}}
   T.near(oc, 2, 0.05, "lie:gauss:cayley s=1 order " .. oc)
+  -- any s: order 2s (exp and Cayley charts)
+  for _, c in ipairs{{"lie:gauss", 1, {0.1, 0.05, 0.025}, 0.05},
+                     {"lie:gauss", 3, {0.2, 0.1, 0.05}, 0.15},
+                     {"lie:gauss", 4, {0.4, 0.2, 0.1}, 0.25},
+                     {"lie:gauss:cayley", 3, {0.2, 0.1, 0.05}, 0.15}} do
+    local o = dm.integrator(top, {method = c[1], stages = c[2]}):order_estimate{state = s0,
+      t = 2, h = c[3]}
+    T.near(o, 2 * c[2], c[4], ("%s s=%d order %.3f"):format(c[1], c[2], o))
+  end
   -- 1e4 steps of the free body, no normalization
   for _, m in ipairs{{"lgvi", 0}, {"lie:gauss", 1}, {"lie:gauss", 2}} do
     local opts = {method = m[1], h = 0.5}
