@@ -604,6 +604,7 @@ void dm_open_conn(lua_State *L)
   lua_settop(L, dm);
   dm_lua_open_conn_cont(L);
   dm_lua_open_conn_disc(L);
+  dm_lua_open_conn_dmech(L);
   dm_lua_open_conn_mesh(L);
   lua_settop(L, dm);
   /* the catalog lua/dmech/bundles.lua and dm.plot_convergence

@@ -2,8 +2,8 @@
  * bundles), l_conn_point.c (their points), l_conn_args.c (readers of
  * shapes, group elements, options), l_conn_cont.c (dm.connection,
  * dm.mechanical_connection), l_conn_disc.c (dm.discrete_connection,
- * dm.discrete_mechanical_connection, dm.order_test), l_conn_mesh.c (the
- * Levi-Civita connection of a triangle mesh).
+ * dm.order_test), l_conn_dmech.c (dm.discrete_mechanical_connection),
+ * l_conn_mesh.c (the Levi-Civita connection of a triangle mesh).
  *
  * A bundle is a userdata "dmech.bundle" owning a dm_conn_bundle; user value
  * 1 is a table {group = <dm.lie group userdata>, L = <reduced Lagrangian
@@ -109,7 +109,15 @@ dm_conn *dm_lua_toconn(lua_State *L, int idx);
 void dm_lua_open_conn_cont(lua_State *L);
 /* discrete (l_conn_disc.c) and mesh (l_conn_mesh.c) connections */
 dm_conn_dc *dm_lua_todconn(lua_State *L, int idx);
+/* Push an empty discrete connection on the bundle at bidx (user value
+ * {bundle = B}); returns its slot for the dm_conn_dc, NULL until set. */
+dm_conn_dc **dm_lua_newdconn(lua_State *L, int bidx);
+/* Set field key of the user value table of the discrete connection at idx
+ * to the value at vidx (keeps it alive: guess, parent). */
+void dm_lua_dconn_setfield(lua_State *L, int idx, const char *key, int vidx);
 void dm_lua_open_conn_disc(lua_State *L);
+/* dm.discrete_mechanical_connection (l_conn_dmech.c) */
+void dm_lua_open_conn_dmech(lua_State *L);
 void dm_lua_open_conn_mesh(lua_State *L);
 /* the mesh connection constructor (dm.discrete_connection{mesh = M}) */
 int dm_lua_meshconn_new(lua_State *L, int midx);
