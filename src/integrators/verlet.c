@@ -329,8 +329,9 @@ static void drift(const dm_prk *P, double h, const double *q, const double *p, c
  * the force and a few additions, not loads of values just stored.  Same
  * arithmetic as dm_prk_verlet_step called substep by substep, so results
  * are bitwise identical to stepping (and to a composition's step()).
- * q, p are written at step boundaries only: after a failure they hold the
- * state after *done steps. */
+ * q, p serve as scratch during the loop (one substep a step) or are
+ * written at step boundaries: on return (also after a failure or Ctrl-C)
+ * they hold the state after *done steps. */
 int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long nsteps,
                           double *q, double *p, long *done, dm_integ_stats *stt, dm_err *e)
 {
@@ -422,12 +423,20 @@ int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long 
       st = dm_err_set(e, DM_EDOM, "the step produced a non-finite state (NaN or Inf; h = %g)", h);
       break;
     }
-    for (i = 0; i < n; i++) {
-      qw[i] = qs[i];
-      pw[i] = pn[i];
+    if (ns == 1) {
+      /* the new state by renaming, not copying (two fewer passes over
+       * four arrays a step: what the loop costs above a few hundred
+       * coordinates is memory traffic); copied out at the end */
+      tmp = qw, qw = qs, qs = qt, qt = tmp;
+      tmp = pw, pw = pn, pn = tmp;
+    } else {
+      for (i = 0; i < n; i++) {
+        qw[i] = qs[i];
+        pw[i] = pn[i];
+      }
+      tmp = qs, qs = qt, qt = tmp;
     }
     tmp = f0, f0 = f1, f1 = tmp;
-    tmp = qs, qs = qt, qt = tmp;
     tmp = cqc, cqc = cqs, cqs = cqt, cqt = tmp;
     tmp = uc, uc = us, us = ut, ut = tmp;
     hk = hk1;
@@ -435,11 +444,17 @@ int dm_prk_verlet_advance(dm_prk *P, double h, const double *g, size_t ns, long 
     j = jn;
     if (j == 0) {
       k++;
-      if (qw != q) {
+      if (ns > 1) {
         dm_vcopy(q, qw, n);
         dm_vcopy(p, pw, n);
       }
     }
+  }
+  if (ns == 1) {                 /* the state after k steps, where it is */
+    if (qw != q)
+      dm_vcopy(q, qw, n);
+    if (pw != p)
+      dm_vcopy(p, pw, n);
   }
   *done = k;
   if (stt) {
