@@ -434,8 +434,10 @@ int main(void)
     return tap_done();
   EXPECT(&s, 0, "dm> ", "third session prompt");
   mark = s.len;
-  send(&s, "print('spin' .. 'ning'); while true do local ok, e = pcall(function() while true do end "
-           "end); io.write('ca' .. 'ught: ', tostring(e), '\\n') end\r");
+  /* "spinning" comes from inside the pcall: a Ctrl-C that lands before it
+   * would stop the whole line */
+  send(&s, "while true do local ok, e = pcall(function() io.write('spin' .. 'ning\\n') io.flush() "
+           "while true do end end); io.write('ca' .. 'ught: ', tostring(e), '\\n') end\r");
   EXPECT(&s, mark, "spinning", "the loop started");
   mark = s.len;
   send(&s, "\x03");
