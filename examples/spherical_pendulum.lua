@@ -46,7 +46,7 @@ local rk = dm.integrator(polar, {method = "rk4", h = 0.02}):run({q = {th, ph}, v
 -- errors against the start, as columns
 local E0, Lz0 = lg:column("energy")[1], x0[1] * m * v0[2] - x0[2] * m * v0[1]
 lg:derive("dE", function(s) return math.abs(s.energy - E0) end)
-lg:derive("dLz", function(s) return math.abs(s.x * s.p_y - s.y * s.p_x - Lz0) end)
+lg:derive("dLz", function(s) return math.abs(s.momentum_3 - Lz0) end)   -- (x ^ p)_z
 lg:derive("dr", function(s) return math.abs(math.sqrt(s.x^2 + s.y^2 + s.z^2) - 1) end)
 rk:derive("dE", function(s) return math.abs(s.energy - E0) end)
 rk:derive("dLz", function(s) return math.abs(s.p_ph - Lz0) end)

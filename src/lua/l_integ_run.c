@@ -67,15 +67,17 @@ static const char *const run_keys[] = {"steps", "t", "every", "progress", "energ
 
 /* momentum = nil | boolean | {coordinate names}: the flags of the
  * momentum columns.  Without a Lagrangian system (ls NULL: a system on a
- * group) the columns are those of the system's momentum map, all or none. */
+ * group), or for one with a momentum map (on S^2), the columns are those
+ * of the system's momentum map, all or none. */
 static void read_momentum(lua_State *L, int o, const dm_lsystem *ls, const dm_system *sys,
                           unsigned char *mom)
 {
   int type = lua_getfield(L, o, "momentum");
-  if (ls == NULL) {
+  if (ls == NULL || sys->momentum_map != NULL) {
     if (type != LUA_TNIL && type != LUA_TBOOLEAN)
-      luaL_error(L, "run: option 'momentum' must be a boolean for a system on a group (the "
-                 "spatial momentum columns momentum_1..), got %s", luaL_typename(L, -1));
+      luaL_error(L, "run: option 'momentum' must be a boolean for a system on %s (the "
+                 "%s momentum columns momentum_1..), got %s", ls == NULL ? "a group" :
+                 sys->space, ls == NULL ? "spatial" : "angular", luaL_typename(L, -1));
     memset(mom, sys->momentum_map != NULL && (type == LUA_TNIL || lua_toboolean(L, -1)),
            sys->n);
   } else if (type == LUA_TNIL) {

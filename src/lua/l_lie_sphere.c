@@ -217,7 +217,17 @@ void dm_lua_sphere_fields(lua_State *L, size_t n)
   lua_replace(L, 1);
 }
 
-/* Make the traced system one on S^n (kind "sphere", its families). */
+/* S^2: the momentum map of SO(3) acting on it, the angular momentum x ^ p */
+static void angular_momentum(const dm_system *sys, const double *x, const double *p, double *J)
+{
+  (void)sys;
+  J[0] = x[1] * p[2] - x[2] * p[1];
+  J[1] = x[2] * p[0] - x[0] * p[2];
+  J[2] = x[0] * p[1] - x[1] * p[0];
+}
+
+/* Make the traced system one on S^n (kind "sphere", its families; on S^2
+ * runs record the angular momentum). */
 void dm_lua_sphere_system(lua_State *L, dm_system *sys, size_t n)
 {
   static const char *const names[] = {"S^1", "S^2", "S^3", "S^4", "S^5", "S^6", "S^7", "S^8"};
@@ -230,6 +240,8 @@ void dm_lua_sphere_system(lua_State *L, dm_system *sys, size_t n)
     dm_lua_fail(L, "dm.system", st, &e);
   sys->kind = DM_SYSTEM_SPHERE;
   sys->space = n <= 8 ? names[n - 1] : "S^n";
+  if (n == 2)
+    sys->momentum_map = angular_momentum;
 }
 
 /* }====================================================================== */

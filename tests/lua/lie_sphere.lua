@@ -64,8 +64,18 @@ T.group("a system on S^2", function()
   local back = dm.load_trajectory(f)
   T.ok(back:meta().space == "S^2" and #back == #tr, "loaded: space S^2, every sample")
   T.near(back:column("p_x3"), tr:column("p_x3"), 0, "CSV round trip: p_x3 bit for bit")
-  T.is(table.concat(tr:names(), ","), "t,x1,x2,x3,p_x1,p_x2,p_x3,v_x1,v_x2,v_x3,energy",
-       "columns: no momentum of a 'cyclic' x1, x2 (the sphere couples them)")
+  T.is(table.concat(tr:names(), ","), "t,x1,x2,x3,p_x1,p_x2,p_x3,v_x1,v_x2,v_x3,energy,"
+       .. "momentum_1,momentum_2,momentum_3", "columns: the angular momentum x ^ p, not "
+       .. "p_x1, p_x2 of 'cyclic' x1, x2 (the sphere couples them)")
+  local s = tr[21]
+  T.near(dm.vec{s.momentum_1, s.momentum_2, s.momentum_3},
+         dm.vec{s.q[2] * s.p[3] - s.q[3] * s.p[2], s.q[3] * s.p[1] - s.q[1] * s.p[3],
+                s.q[1] * s.p[2] - s.q[2] * s.p[1]}, 1e-15, "momentum_k = (x ^ p)_k")
+  T.is(#dm.integrator(pend, {h = 0.01}):run(s0, {steps = 2, momentum = false}):names(), 11,
+       "momentum = false: no momentum columns")
+  T.error_like(function() dm.integrator(pend, {h = 0.01}):run(s0, {steps = 2,
+    momentum = {"x1"}}) end, "run: option 'momentum' must be a boolean for a system on S%^2 "
+    .. "%(the angular momentum columns momentum_1%.%.%), got table", "momentum = {names} refused")
   T.near(tr:column("p_x2")[1], m * v0[2], 1e-15, "p = m v at the start")
   local named = dm.system{space = S2, coords = {"x", "y", "z"}, params = {m = m, g = g},
     L = Lcart}
@@ -92,6 +102,9 @@ T.group("spherical pendulum: invariants over 10^4 steps", function()
   local dl = maxdev(lz, 1, #lz)
   T.ok(dl < 1e-13,
        "vertical angular momentum (x p)_z conserved: " .. dl .. " (of " .. lz[1] .. ")")
+  T.conserved(tr, "momentum_3", 1e-13, "the column momentum_3 conserved")
+  local m1 = tr:column("momentum_1")
+  T.ok(maxdev(m1, 1, #m1) > 0.1, "momentum_1 is not (gravity's torque): " .. maxdev(m1, 1, #m1))
   local e = tr:column("energy")
   local half = (#e + 1) // 2
   local e1, e2 = maxdev(e, 1, half), maxdev(e, half, #e)
