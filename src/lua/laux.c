@@ -16,6 +16,10 @@ int dm_lua_fail(lua_State *L, const char *what, int status, const dm_err *e)
   const char *msg = (e != NULL && e->status == status && e->msg[0] != '\0'
                      && memchr(e->msg, '\0', sizeof e->msg) != NULL)
                     ? e->msg : dm_strstatus(status);
+  size_t n = strlen(what);
+  /* a message that already starts with "<what>: " is not prefixed twice */
+  if (strncmp(msg, what, n) == 0 && msg[n] == ':' && msg[n + 1] == ' ')
+    return luaL_error(L, "%s", msg);
   return luaL_error(L, "%s: %s", what, msg);
 }
 

@@ -97,6 +97,19 @@ static int about_memory(const char *msg)
   return strstr(low, "memory") != NULL;
 }
 
+/* "trajectory: trajectory: out of memory": a prefix said twice */
+static int stutters(const char *msg)
+{
+  for (const char *w = msg; *w != '\0'; w++) {
+    if (w != msg && w[-1] != ' ')
+      continue;
+    size_t n = strcspn(w, ": ");
+    if (n > 0 && w[n] == ':' && w[n + 1] == ' ' && strncmp(w + n + 2, w, n + 1) == 0)
+      return 1;
+  }
+  return 0;
+}
+
 /* Scenario s with its k-th allocation refused; 0 when something is wrong
  * (diagnosed: an unclear message, an unusable session, memory not given
  * back when the state is closed), else 1.  *errors counts the runs that
@@ -118,7 +131,7 @@ static int one(const struct scenario *s, long k, long *errors, char *first_msg)
   ip_fail_at(0);
   if (!ok) {
     (*errors)++;
-    if (!about_memory(msg)) {
+    if (!about_memory(msg) || stutters(msg)) {
       tap_diag("%s, allocation %ld refused: unclear error: %s", s->name, k, msg);
       lua_close(L);
       return 0;
