@@ -616,7 +616,8 @@ static const dm_reg integ_methods[] = {
    "is the physical time, a column h holds the step lengths and t = T ends exactly at T."},
   {"symplecticity_defect", i_defect, "integ:symplecticity_defect(state[, h]) -> number",
    "The largest entry of |DPhi^T J DPhi - J| for one step at the state, DPhi by implicit differentiation of the "
-   "step equations (exact Jacobians)."},
+   "step equations (exact Jacobians); on a sphere the defect of dx ^ dp restricted to T*S^n "
+   "(DPhi along it by central differences, doc/lie.md)."},
   {"jacobian", i_jacobian, "integ:jacobian(state[, h]) -> mat",
    "The 2n x 2n Jacobian D(q1, p1)/D(q0, p0) of one step at the state."},
   {"reversal", i_reversal, "integ:reversal(state, n[, h]) -> number",
@@ -635,7 +636,7 @@ static const dm_reg integ_methods[] = {
    "integ:order_estimate{state=, t=, h={h1, h2, ...}[, reference=state]} -> order, errors",
    "Integrate to time t with this integrator's method and options at each step size and fit the "
    "slope of log(error) against log(h); the reference is Gauss 6 (Lobatto 6 with constraints) "
-   "at h_min/8 unless given."},
+   "at h_min/8 unless given (on a sphere, where neither applies: the method at h_min/64)."},
   {"reset", i_reset, "integ:reset() -> integ",
    "Forget the step history (predictor, compensated-summation carries) and the statistics."},
   {NULL, NULL, NULL, NULL}
