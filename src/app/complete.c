@@ -30,137 +30,16 @@
 #include <lauxlib.h>
 #include <lua.h>
 
+#include "app/complete_lex.h"
 #include "app/repl.h"
 
 #ifdef HAVE_READLINE
 #include <readline/readline.h>
 
 #define MAX_CHAIN 8
-#define MAX_TOKENS 2048
-#define MAX_DEPTH 64
 
 static lua_State *complL = NULL;
 static const char *const break_chars = " \t\n\"\\'`@$><=;|&{(,+-*/^%[]#~)";
-
-/* {======================================================================
- * reading the line: tokens and open brackets
- * ======================================================================= */
-
-enum { T_NAME, T_STRING, T_OPENSTR, T_NUMBER, T_OP };
-
-typedef struct token {
-  int type;
-  size_t start, end;     /* [start, end) in the line; for strings the quotes included */
-} token;
-
-typedef struct lexed {
-  token tok[MAX_TOKENS];
-  int ntok;
-  int open[MAX_DEPTH];   /* token indices of the open brackets, innermost last */
-  int nopen;
-  int in_comment;        /* the cursor is in a comment */
-} lexed;
-
-/* Tokens of line[0, end).  Returns 0 when the line is too long to read. */
-static int lex(const char *s, size_t end, lexed *x)
-{
-  size_t i = 0;
-  x->ntok = x->nopen = x->in_comment = 0;
-  while (i < end) {
-    unsigned char c = (unsigned char)s[i];
-    token *t;
-    if (isspace(c)) {
-      i++;
-      continue;
-    }
-    if (x->ntok == MAX_TOKENS)
-      return 0;
-    t = &x->tok[x->ntok];
-    t->start = i;
-    if (c == '-' && i + 1 < end && s[i + 1] == '-') {
-      x->in_comment = 1;                      /* a comment runs to the cursor */
-      return 1;
-    }
-    if (isalpha(c) || c == '_') {
-      while (i < end && (isalnum((unsigned char)s[i]) || s[i] == '_'))
-        i++;
-      t->type = T_NAME;
-    } else if (isdigit(c) || (c == '.' && i + 1 < end && isdigit((unsigned char)s[i + 1]))) {
-      while (i < end && (isalnum((unsigned char)s[i]) || s[i] == '.'))
-        i++;
-      t->type = T_NUMBER;
-    } else if (c == '"' || c == '\'') {
-      i++;
-      t->type = T_OPENSTR;
-      while (i < end) {
-        if (s[i] == '\\') {
-          i += 2;
-          continue;
-        }
-        if ((unsigned char)s[i++] == c) {
-          t->type = T_STRING;
-          break;
-        }
-      }
-      if (i > end)
-        i = end;
-    } else if (c == '[' && i + 1 < end && (s[i + 1] == '[' || s[i + 1] == '=')) {
-      /* a long string: skip to its closing bracket (or the cursor) */
-      size_t level = 0, j = i + 1;
-      while (j < end && s[j] == '=')
-        level++, j++;
-      t->type = T_OPENSTR;
-      for (j = j + 1; j < end; j++)
-        if (s[j] == ']') {
-          size_t k = j + 1, l = 0;
-          while (k < end && s[k] == '=')
-            l++, k++;
-          if (l == level && k < end && s[k] == ']') {
-            t->type = T_STRING;
-            j = k;
-            break;
-          }
-        }
-      i = j + 1 < end ? j + 1 : end;
-      if (t->type == T_OPENSTR)
-        return 0;                              /* no completion inside a long string */
-    } else {
-      i++;
-      t->type = T_OP;
-      if (c == '(' || c == '{' || c == '[') {
-        if (x->nopen < MAX_DEPTH)
-          x->open[x->nopen++] = x->ntok;
-      } else if ((c == ')' || c == '}' || c == ']') && x->nopen > 0) {
-        x->nopen--;
-      }
-    }
-    t->end = i;
-    x->ntok++;
-  }
-  return 1;
-}
-
-static int is_op(const lexed *x, const char *s, int k, char c)
-{
-  return k >= 0 && k < x->ntok && x->tok[k].type == T_OP && s[x->tok[k].start] == c;
-}
-
-/* The path ending at token k (NAME ('.' NAME)* [':' NAME]): returns the
- * index of its first token, or -1 when token k does not end a path. */
-static int path_start(const lexed *x, const char *s, int k)
-{
-  if (k < 0 || x->tok[k].type != T_NAME)
-    return -1;
-  while (k >= 2 && x->tok[k - 2].type == T_NAME && (is_op(x, s, k - 1, '.') || is_op(x, s, k - 1, ':')))
-    k -= 2;
-  /* a path preceded by '.' or ':' belongs to an expression we cannot read */
-  if (k >= 1 && (is_op(x, s, k - 1, '.') || is_op(x, s, k - 1, ':') || is_op(x, s, k - 1, ']')
-                 || is_op(x, s, k - 1, ')')))
-    return -1;
-  return k;
-}
-
-/* }====================================================================== */
 
 /* {======================================================================
  * values, read without running user code
@@ -452,7 +331,7 @@ static void collect_names(lua_State *L, const char *part, int cands, int depth)
 /* Push the value of the path whose tokens end at token k, or nil. */
 static void push_path_tokens(lua_State *L, const lexed *x, const char *s, int k)
 {
-  int a = path_start(x, s, k);
+  int a = dm_lex_path_start(x, s, k);
   if (a < 0)
     lua_pushnil(L);
   else
@@ -464,10 +343,10 @@ static void push_path_tokens(lua_State *L, const lexed *x, const char *s, int k)
 static int first_element(const lexed *x, const char *s, int b)
 {
   int k = b + 1;
-  while (k + 2 < x->ntok && x->tok[k].type == T_NAME && (is_op(x, s, k + 1, '.')))
+  while (k + 2 < x->ntok && x->tok[k].type == T_NAME && (dm_lex_is_op(x, s, k + 1, '.')))
     k += 2;
   if (k < x->ntok && x->tok[k].type == T_NAME && k + 1 < x->ntok
-      && (is_op(x, s, k + 1, ',') || is_op(x, s, k + 1, ';')))
+      && (dm_lex_is_op(x, s, k + 1, ',') || dm_lex_is_op(x, s, k + 1, ';')))
     return k;
   return -1;
 }
@@ -484,7 +363,7 @@ static void string_names(lua_State *L, const lexed *x, const char *s, const char
     if (c == '[') {                                     /* t["k */
       push_path_tokens(L, x, s, before);
       collect_names(L, part, cands, 0);
-    } else if (c == '(' && before >= 2 && is_op(x, s, before - 1, ':')) {  /* obj:m("x */
+    } else if (c == '(' && before >= 2 && dm_lex_is_op(x, s, before - 1, ':')) {  /* obj:m("x */
       push_path_tokens(L, x, s, before - 2);
       collect_names(L, part, cands, 0);
     } else if (c == '(') {                              /* f(obj, "x */
@@ -521,11 +400,11 @@ static void option_keys(lua_State *L, const lexed *x, const char *s, int last, c
     return;
   /* a key position: right after '{', ',' or ';' */
   k = last;
-  if (!(k == b || is_op(x, s, k, ',') || is_op(x, s, k, ';')))
+  if (!(k == b || dm_lex_is_op(x, s, k, ',') || dm_lex_is_op(x, s, k, ';')))
     return;
   if (b >= 1 && x->tok[b - 1].type == T_NAME) {
     callee = b - 1;                                     /* f{ */
-  } else if (x->nopen >= 2 && (is_op(x, s, b - 1, '(') || is_op(x, s, b - 1, ','))) {
+  } else if (x->nopen >= 2 && (dm_lex_is_op(x, s, b - 1, '(') || dm_lex_is_op(x, s, b - 1, ','))) {
     int p = x->open[x->nopen - 2];
     if (s[x->tok[p].start] != '(')
       return;
@@ -536,11 +415,11 @@ static void option_keys(lua_State *L, const lexed *x, const char *s, int last, c
   if (callee < 0 || x->tok[callee].type != T_NAME)
     return;
   {
-    int a = path_start(x, s, callee);
+    int a = dm_lex_path_start(x, s, callee);
     if (a < 0)
       return;
     push_docs(L);
-    if (callee >= 2 && is_op(x, s, callee - 1, ':')) {    /* obj:m(..., { */
+    if (callee >= 2 && dm_lex_is_op(x, s, callee - 1, ':')) {    /* obj:m(..., { */
       const char *kind;
       push_path(L, s, x->tok[a].start, x->tok[callee - 2].end);
       kind = dmech_kind(L, -1);
@@ -586,7 +465,7 @@ static char *word_break_hook(void)
 {
   static lexed x;
   quote_char = '\0';
-  if (lex(rl_line_buffer, (size_t)rl_point, &x) && x.ntok > 0 && !x.in_comment
+  if (dm_lex(rl_line_buffer, (size_t)rl_point, &x) && x.ntok > 0 && !x.in_comment
       && x.tok[x.ntok - 1].type == T_OPENSTR) {
     quote_char = rl_line_buffer[x.tok[x.ntok - 1].start];
     return quote_char == '"' ? "\"" : "'";
@@ -711,7 +590,7 @@ static char **dm_completion(const char *text, int start, int end)
   (void)end;
   rl_attempted_completion_over = 1;        /* never fall back to file names */
   rl_completion_append_character = '\0';   /* reset by Readline each time */
-  if (L == NULL || !lex(rl_line_buffer, (size_t)rl_point, &x) || x.in_comment)
+  if (L == NULL || !dm_lex(rl_line_buffer, (size_t)rl_point, &x) || x.in_comment)
     return NULL;
   top = lua_gettop(L);
   if (!lua_checkstack(L, 40))
@@ -736,7 +615,7 @@ static char **dm_completion(const char *text, int start, int end)
         lua_rawset(L, cands);
       }
     }
-    if (k >= 0 && (is_op(&x, rl_line_buffer, k, '.') || is_op(&x, rl_line_buffer, k, ':'))) {
+    if (k >= 0 && (dm_lex_is_op(&x, rl_line_buffer, k, '.') || dm_lex_is_op(&x, rl_line_buffer, k, ':'))) {
       lua_settop(L, top);                  /* after an expression we cannot read */
       return NULL;
     }
