@@ -544,7 +544,20 @@ static void emit_entry(em *E, sbuf *b, const dm_native_map *outmap, size_t nmap)
     ta[nt] = outmap[j].arr;
     te[nt++] = outmap[j].elem;
   }
-  if (nt > 0) {
+  size_t run = 1;                      /* out[ta[0]][te[0] + j], j < nt? */
+  while (run < nt && ta[run] == ta[0] && te[run] == te[0] + run)
+    run++;
+  if (nt > 0 && run == nt) {
+    /* one contiguous run (a gradient into one array): a plain loop, no
+     * index tables to read */
+    sb_printf(b, "  const double *restrict c = out[%u] + %u;\n"
+              "  double s0 = 0.0, s1 = 0.0;\n  size_t j = 0;\n"
+              "  for (; j + 2 <= %zu; j += 2) {\n    s0 += c[j];\n    s1 += c[j + 1];\n  }\n"
+              "  if (j < %zu)\n    s0 += c[j];\n"
+              "  if (!(s0 + s1 <= DBL_MAX)) {\n    int bad = 0;\n"
+              "    for (j = 0; j < %zu; j++)\n      bad |= !(fabs(c[j]) <= DBL_MAX);\n"
+              "    return bad;\n  }\n", ta[0], te[0], nt, nt, nt);
+  } else if (nt > 0) {
     sb_printf(b, "  static const unsigned char ca[%zu] = {", nt);
     for (size_t j = 0; j < nt; j++)
       sb_printf(b, "%s%u", j == 0 ? "\n    " : j % 32 ? "," : ",\n    ", ta[j]);

@@ -174,6 +174,34 @@ static void test_chunks(void)
   in[1] = 1.5;                          /* sqrt(1.2 - y): NaN */
   rc = dm_native_scatter(nat)(ins, par, outs, 7u, work);
   tap_is_int(rc, 1, "an output NaN: the scatter reports 1");
+  dm_native_free(nat);
+  /* every output once, in order, into one array (a gradient): the NaN
+   * test is a plain loop over it, not index tables */
+  static double g[2 * K];
+  dm_native_map gm[2 * K];
+  for (uint32_t k = 0; k < 2 * K; k++)
+    gm[k] = (dm_native_map){ k, 0, k };
+  double *gouts[1] = { g };
+  st = dm_native_compile_mapped(t, base, base + 3, im, 2 * K, gm, &nat, &err);
+  in[1] = 0.9;
+  rc = st == DM_OK ? dm_native_scatter(nat)(ins, par, gouts, 1u, work) : -1;
+  same = rc == 0;
+  for (int k = 0; k < 2 * K; k++)
+    same &= agree(g[k], o[k]);
+  tap_ok(same, "scatter into one array, every output in order: = tape");
+  in[1] = 1.5;
+  rc = st == DM_OK ? dm_native_scatter(nat)(ins, par, gouts, 1u, work) : -1;
+  int nans = 0;
+  for (int k = 0; k < 2 * K; k++)
+    nans += isnan(g[k]);
+  tap_ok(rc == 1 && nans > 0, "... and an output NaN: reported (%d NaN outputs)", nans);
+  in[1] = 0.9;
+  par[0] = HUGE_VAL;                    /* the quotients become infinite, not NaN */
+  rc = st == DM_OK ? dm_native_scatter(nat)(ins, par, gouts, 1u, work) : -1;
+  nans = 0;
+  for (int k = 0; k < 2 * K; k++)
+    nans += isinf(g[k]) ? 1 : 0;
+  tap_ok(rc == 1 && nans > 0, "... and an infinite one: reported (%d infinite outputs)", nans);
   free(w);
   dm_native_free(nat);
   dm_tape_free(t);
