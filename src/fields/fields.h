@@ -2,7 +2,8 @@
  * the pseudospectral Schrodinger integrator (schrodinger.c), the 1-D
  * multiscale finite element method exact at the nodes (msfem.c), and the
  * multisymplectic integrators of the nonlinear wave equation on space-time
- * grids (msym.c) and on DEC meshes in space (msym_dec.c).
+ * grids (msym.c), on moving r-adaptive nodes (radapt.c) and on DEC meshes in
+ * space (msym_dec.c).
  *
  * Ownership.  Every _alloc returns a new object in *out that the caller
  * releases with the matching _free (NULL is a no-op); all workspaces are
@@ -192,6 +193,47 @@ int dm_msym_form_check(dm_msym *M, const double *u, const double *p, const doubl
 /* The plane-wave dispersion relation of the scheme (V = 0): the omega with
  * tan(omega dt/2)/dt = c tan(k dx/2)/dx. */
 double dm_msym_dispersion(const dm_msym *M, double k);
+
+/* {---- moving nodes, r-adaptive (radapt.c) ----
+ * Ends held at x0 and x0 + length, N cells, the interior nodes X_i move.
+ * A space-time cell with corners (X_k^j, X_{k+1}^j, X_k^{j+1}, X_{k+1}^{j+1})
+ * has L_d = hb dt l(u_t, u_x, ubar), hb its mean width, u_x = u_xi/hb,
+ * u_t the time derivative at fixed x, (u_T - u_B - (X_T - X_B) u_x)/dt
+ * along a vertical edge: its square sampled at the cell centre
+ * (DM_RADAPT_CENTRE: the mean of the two edges; on a still uniform mesh
+ * msym.c's cell) or averaged over the two edges (DM_RADAPT_EDGES: lumped
+ * mass; immune to the odd-even node oscillation the centre rule shows on
+ * steep fronts at small dt).  The field's discrete
+ * Euler-Lagrange equations treat the mesh as a given (time-dependent)
+ * control; the mesh of each new level solves the arc-length
+ * equidistribution sqrt(h_k^2 + alpha du_k^2) equal for all cells, i.e.
+ * h_k rho_k = const with rho = sqrt(1 + alpha u_x^2).  Both by Newton on the
+ * interleaved unknowns (u_i, X_i), banded LU of GSL (3 + 3 diagonals). */
+typedef struct dm_radapt dm_radapt;
+enum { DM_RADAPT_CENTRE, DM_RADAPT_EDGES };
+
+/* alpha >= 0 (0: the mesh stays uniform to round-off); rule one of the
+ * two above. */
+int dm_radapt_alloc(size_t N, double x0, double length, double c, double dt, double alpha,
+                    int rule, const dm_potential *V, dm_radapt **out, dm_err *e);
+void dm_radapt_free(dm_radapt *R);
+size_t dm_radapt_nodes(const dm_radapt *R);            /* N + 1 */
+double dm_radapt_dt(const dm_radapt *R);
+double dm_radapt_alpha(const dm_radapt *R);
+/* The initial mesh X (N + 1) equidistributed for the field u0 (de Boor's
+ * iteration on the piecewise-linear interpolant), u = u0(X). */
+int dm_radapt_init(dm_radapt *R, dm_fn1 u0, void *data, double *X, double *u, dm_err *e);
+/* p_i = (X_{i+1} - X_{i-1})/2 v_i at the interior nodes, 0 at the ends. */
+void dm_radapt_momentum(const dm_radapt *R, const double *X, const double *v, double *p);
+/* One step (X, u, p) -> (X1, u1, p1) (outputs may alias inputs);
+ * DM_EDIVERGED if nodes crossed. */
+int dm_radapt_step(dm_radapt *R, const double *X0, const double *u0, const double *p0,
+                   double *X1, double *u1, double *p1, dm_err *e);
+/* max_i |l_i - l_{i-1}| / mean l, l_k the arc length of cell k. */
+double dm_radapt_residual(const dm_radapt *R, const double *X, const double *u);
+/* sum p_i^2/(2 m_i) + m_i V(u_i) + sum_k h_k c^2 ((u_{k+1} - u_k)/h_k)^2/2,
+ * m_i = (X_{i+1} - X_{i-1})/2 (msym.c's energy on a uniform mesh). */
+double dm_radapt_energy(const dm_radapt *R, const double *X, const double *u, const double *p);
 
 /* {---- DEC meshes in space (msym_dec.c) ----
  * u a primal 0-cochain on a mesh of any dimension (1-D paths, triangle
