@@ -201,11 +201,43 @@ double dm_radapt_residual(const dm_radapt *R, const double *X, const double *u)
   return worst / (tot / (double)R->N);
 }
 
+/* The last digits of an initial mesh: Newton on the equidistribution for X
+ * with the nodal values held (they move by the mesh's change times u_x,
+ * at round-off), tridiagonal (GSL). */
+static int polish(dm_radapt *R, double *X, const double *u, dm_err *e)
+{
+  size_t N = R->N, m = N - 1, i;
+  double *dg = R->Xn, *lo = R->S, *up = R->dX, *rhs = R->rhs, *sol = R->sol;
+  for (int it = 0; it < 4; it++) {
+    for (size_t k = 0; k < N; k++)
+      R->ell[k] = arc(R, X, u, k);
+    for (i = 1; i < N; i++) {
+      double gl = (X[i] - X[i - 1]) / R->ell[i - 1], gr = (X[i + 1] - X[i]) / R->ell[i];
+      rhs[i - 1] = R->ell[i] - R->ell[i - 1];
+      dg[i - 1] = -gr - gl;
+      if (i > 1)
+        lo[i - 2] = gl;
+      if (i + 1 < N)
+        up[i - 1] = gr;
+    }
+    gsl_vector_view d = gsl_vector_view_array(dg, m), a = gsl_vector_view_array(up, m - 1),
+                    b = gsl_vector_view_array(lo, m - 1), r = gsl_vector_view_array(rhs, m),
+                    x = gsl_vector_view_array(sol, m);
+    if (gsl_linalg_solve_tridiag(&d.vector, &a.vector, &b.vector, &r.vector, &x.vector)
+        != GSL_SUCCESS)
+      return dm_err_set(e, DM_ESINGULAR, "r-adaptive: singular mesh equations");
+    for (i = 1; i < N; i++)
+      X[i] -= sol[i - 1];
+  }
+  return DM_OK;
+}
+
 int dm_radapt_init(dm_radapt *R, dm_fn1 u0, void *data, double *X, double *u, dm_err *e)
 {
   size_t N = R->N, i, k;
   double d = HUGE_VAL, dprev = HUGE_VAL;
   int it;
+  R->have_last = 0;
   for (i = 0; i <= N; i++)
     X[i] = R->x0 + R->length * (double)i / (double)N;
   /* de Boor's iteration: place the nodes at equal arc length of the
@@ -217,7 +249,7 @@ int dm_radapt_init(dm_radapt *R, dm_fn1 u0, void *data, double *X, double *u, dm
         return dm_err_set(e, DM_EDOM, "r-adaptive: the initial field fails at x = %g", X[i]);
     }
     if (d <= 4 * DBL_EPSILON * R->length || (it > 50 && d >= dprev && d <= 1e-12 * R->length))
-      return DM_OK;
+      return polish(R, X, u, e);
     dprev = d;
     R->S[0] = 0;
     for (k = 0; k < N; k++)
