@@ -1,4 +1,4 @@
-/* fields.h -- variational integrators for fields (doc/beyond-fixed-steps.md §4-6):
+/* fields.h -- variational integrators for fields (doc/beyond-fixed-steps.md §4-7):
  * the pseudospectral Schrodinger integrator (schrodinger.c), the 1-D
  * multiscale finite element method exact at the nodes (msfem.c), and the
  * multisymplectic integrators of the nonlinear wave equation on space-time
