@@ -220,7 +220,7 @@ static void steep(void)
   double X[81], u[81];
   runstat r = kink_run(80, 40, 0.0625, 4.0, DM_RADAPT_EDGES, &K, 10, X, u);
   double eu = uniform_run(80, 40, 0.0625, &K, 10), dense = HUGE_VAL;
-  tap_ok(r.st == DM_OK, "steep kink: 160 steps (%s)", r.msg);
+  tap_ok(r.st == DM_OK, "steep kink: 160 steps%s%s", r.st ? ": " : "", r.msg);
   tap_ok(r.ordered && r.hmin > 0, "the nodes never cross (smallest cell %.4f)", r.hmin);
   tap_ok(r.res < 1e-13, "equidistribution at solver tolerance at the start and every step (%.2e)", r.res);
   /* the nodes crowd at the kink, now at x = 4.5 */
