@@ -53,6 +53,10 @@ void dm_doc_add(lua_State *L, const char *name, const char *sig,
  * stack. */
 void dm_newclass(lua_State *L, const char *tname, const char *kind,
                  const dm_reg *methods, const luaL_Reg *meta);
+/* The end of an __index metamethod of such a class (when `meta` sets one):
+ * push the method of the object at 1 named by the key at 2, nil when there
+ * is none; returns 1. */
+int dm_index_methods(lua_State *L);
 
 /* A documented field of a class, registered as "<kind>.<name>"; sig NULL
  * means "<kind>.<name>". */

@@ -571,11 +571,7 @@ static int bundle_index(lua_State *L)
       return 1;
     }
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 /* }==== */

@@ -719,11 +719,7 @@ static int conn_index(lua_State *L)
       return 1;
     }
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 static const dm_reg conn_methods[] = {

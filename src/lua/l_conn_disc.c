@@ -544,11 +544,7 @@ static int dconn_index(lua_State *L)
       return 1;
     }
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 /* dm.order_test(Ad, {ref = "transport" | Dref, q = q0, v = {...}, h = {...}, tol = 1e-13}) */

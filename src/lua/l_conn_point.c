@@ -158,11 +158,7 @@ static int point_index(lua_State *L)
     if (strcmp(k, "q") == 0)
       return p_coords(L);
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 static int point_tostring(lua_State *L)

@@ -143,6 +143,15 @@ void dm_newclass(lua_State *L, const char *tname, const char *kind,
   }
 }
 
+int dm_index_methods(lua_State *L)
+{
+  lua_getmetatable(L, 1);
+  lua_getfield(L, -1, "__methods");
+  lua_pushvalue(L, 2);
+  lua_rawget(L, -2);
+  return 1;
+}
+
 void dm_doc_fields(lua_State *L, const char *kind, const dm_field *fields)
 {
   char name[128];

@@ -446,11 +446,7 @@ static int mm_index(lua_State *L)
       return luaL_error(L, "mat row %I out of range 1..%d", i, (int)m->size1);
     return pushrow(L, 1, (size_t)i - 1);
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 static int mm_newindex(lua_State *L)

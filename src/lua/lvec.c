@@ -296,11 +296,7 @@ static int m_index(lua_State *L)
     lua_pushnumber(L, gsl_vector_get(v, checkindex(L, v, 2)));
     return 1;
   }
-  lua_getmetatable(L, 1);
-  lua_getfield(L, -1, "__methods");
-  lua_pushvalue(L, 2);
-  lua_rawget(L, -2);
-  return 1;
+  return dm_index_methods(L);
 }
 
 static int m_newindex(lua_State *L)
