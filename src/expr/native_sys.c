@@ -168,8 +168,8 @@ static double cc_timeout(void)
 }
 
 /* Run argv with stdin from /dev/null and stdout + stderr captured into out
- * (at most size-1 bytes kept, NUL-terminated).  *status is the exit code
- * (128 + signal when killed).  Returns a dm status.
+ * (at most size-1 bytes kept, NUL-terminated).  *status is the exit code,
+ * or minus the signal that killed it.  Returns a dm status.
  *
  * The compiler runs in a process group of its own: the driver `cc` starts
  * cc1, as, ld; on an interrupt or the timeout the whole group is killed
@@ -272,7 +272,7 @@ static int run(char *const argv[], char *out, size_t size, int *status,
     len--;                       /* messages end without a newline */
   out[len] = '\0';
   close(fd[0]);
-  *status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+  *status = WIFEXITED(ws) ? WEXITSTATUS(ws) : -WTERMSIG(ws);
   if (result == DM_EINTR)
     return dm_err_set(err, DM_EINTR, "native: compilation interrupted");
   if (result == DM_ETIMEOUT)
@@ -502,6 +502,27 @@ int dm_native__cache_open(const char *path, char *lpath, size_t size)
 }
 
 /* Compile src into dir/f.so (files in dir, which the caller removes). */
+/* The message of a compiler run that ended with status != 0 (see run):
+ * "native: <cc> failed (exit 1): <its output>" or "... failed (killed by
+ * signal 11, Segmentation fault)" -- no dangling ": " without output. */
+static const char *how_ended(int status, char *how, size_t n)
+{
+  if (status < 0)
+    snprintf(how, n, "killed by signal %d, %s", -status, strsignal(-status));
+  else
+    snprintf(how, n, "exit %d", status);
+  return how;
+}
+
+static int cc_failed(dm_err *err, const char *doing, const char *cc, int status,
+                     const char *msg)
+{
+  char how[96];
+  how_ended(status, how, sizeof how);
+  return dm_err_set(err, DM_EFAILED, "native: %s%s failed (%s)%s%s", doing, cc, how,
+                    msg[0] != '\0' ? ": " : "", msg);
+}
+
 int dm_native__build(char **ccargv, int ncc, const char *dir, const char *src,
                  char *obj, size_t objsize, dm_err *err)
 {
@@ -524,8 +545,7 @@ int dm_native__build(char **ccargv, int ncc, const char *dir, const char *src,
   if (s != DM_OK)
     return s;
   if (status != 0)
-    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s",
-                      ccargv[0], status, msg);
+    return cc_failed(err, "", ccargv[0], status, msg);
   return DM_OK;
 }
 
@@ -579,8 +599,7 @@ static int compile_unit(unit_job *J, size_t k, dm_err *err)
   if (s != DM_OK)
     return s;
   if (status != 0)
-    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s", J->ccargv[0],
-                      status, msg);
+    return cc_failed(err, "", J->ccargv[0], status, msg);
   return DM_OK;
 }
 
@@ -637,8 +656,7 @@ static int build_one(char **ccargv, int ncc, const char *dir, const char *src,
   if (s != DM_OK)
     return s;
   if (status != 0)
-    return dm_err_set(err, DM_EFAILED, "native: %s failed (exit %d): %s", ccargv[0], status,
-                      msg);
+    return cc_failed(err, "", ccargv[0], status, msg);
   return DM_OK;
 }
 
@@ -707,8 +725,7 @@ int dm_native__build_units(char **ccargv, int ncc, const char *dir, char *const 
   if (s != DM_OK)
     return s;
   if (status != 0)
-    return dm_err_set(err, DM_EFAILED, "native: linking with %s failed (exit %d): %s",
-                      ccargv[0], status, msg);
+    return cc_failed(err, "linking with ", ccargv[0], status, msg);
   return DM_OK;
 }
 
@@ -740,9 +757,11 @@ int dm_native__make_key(char **ccargv, int ncc, const char *src, char key[65],
   int s = run(argv, ver, sizeof ver, &status, err);
   if (s != DM_OK)
     return s;
-  if (status != 0)
+  if (status != 0) {
+    char how[96];
     return dm_err_set(err, DM_ENOTFOUND, "native: '%s --version' failed "
-                      "(exit %d)", ccargv[0], status);
+                      "(%s)", ccargv[0], how_ended(status, how, sizeof how));
+  }
   sha256 h;
   sha_init(&h);
   for (int i = 0; i < ncc; i++)

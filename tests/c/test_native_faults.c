@@ -345,8 +345,10 @@ static void test_stopped_compiler(void)
          "failing compiler: DM_EFAILED with its message (%s)", err.msg);
   write_fakecc("crash");
   st = dm_native_compile(t, NULL, NULL, &nat, &err);
-  tap_ok(st == DM_EFAILED && strstr(err.msg, "exit 139"),
-         "crashing compiler: DM_EFAILED, exit 128 + SIGSEGV (%s)", err.msg);
+  tap_ok(st == DM_EFAILED && strstr(err.msg, "failed (killed by signal 11, Segmentation fault)")
+         && err.msg[strlen(err.msg) - 1] == ')',
+         "crashing compiler: DM_EFAILED, killed by SIGSEGV, no empty output quoted (%s)",
+         err.msg);
   tap_is_int(count_build_dirs(), dirs0, "no build directory left");
 
   /* a descriptor another thread has open without close-on-exec (HDF5
