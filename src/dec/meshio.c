@@ -162,7 +162,8 @@ static int read_off(reader *r)
       return rerr(r, "%s", "vertex and face counts expected");
     k = parse_numbers(r->line, x, 3, &bad);
   }
-  if (k < 2 || x[0] < 1 || x[1] < 1 || x[0] != floor(x[0]) || x[1] != floor(x[1]) || x[0] > INT_MAX)
+  if (k < 2 || x[0] < 1 || x[1] < 1 || x[0] != floor(x[0]) || x[1] != floor(x[1]) || x[0] > INT_MAX
+      || x[1] > INT_MAX)
     return rerr(r, "%s", "counts 'vertices faces edges' expected");
   nv = (int)x[0];
   nf = (int)x[1];
@@ -253,6 +254,19 @@ static int read_obj(reader *r)
   return st < 0 ? dm_err_set(r->e, DM_ENOMEM, "%s: out of memory", r->path) : DM_OK;
 }
 
+/* A count or a tag read as a double: the int it is, or -1 (a count) /
+ * INT_MIN (a tag) when it is not a whole number in range -- a cast of
+ * 3.4e10 or NaN to int is undefined. */
+static int msh_count(double v)
+{
+  return v >= 0 && v < INT_MAX && v == floor(v) ? (int)v : -1;
+}
+
+static int msh_tag(double v)
+{
+  return v > INT_MIN && v <= INT_MAX && v == floor(v) ? (int)v : INT_MIN;
+}
+
 /* Gmsh: element type -> dimension of the simplex (or -1: ignored). */
 static int gmsh_dim(int type)
 {
@@ -323,10 +337,11 @@ static int read_msh(reader *r)
     if (strcmp(r->line, "$Nodes") == 0)
       break;
   }
-  if (next_content(r, '\0') != 1 || (k = parse_numbers(r->line, x, 4, &bad)) < 1)
+  if (next_content(r, '\0') != 1 || (k = parse_numbers(r->line, x, 4, &bad)) < (version < 3 ? 1 : 2)
+      || msh_count(x[0]) < 0 || (version >= 3 && msh_count(x[1]) < 0))
     return rerr(r, "%s", "node count expected");
   if (version < 3) {
-    int nn = (int)x[0];
+    int nn = msh_count(x[0]);
     tags = malloc(((size_t)nn + 1) * sizeof *tags);
     if (tags == NULL)
       return dm_err_set(r->e, DM_ENOMEM, "%s: out of memory", r->path);
@@ -344,11 +359,14 @@ static int read_msh(reader *r)
       }
       if ((st = check_coords(r, x + 1, 3)) != DM_OK || (st = add_vertex(r, x + 1, 3)) != DM_OK)
         goto done;
-      tags[i].tag = (int)x[0];
+      if ((tags[i].tag = msh_tag(x[0])) == INT_MIN) {
+        st = rerr(r, "%s", "node 'tag x y z' expected");
+        goto done;
+      }
       tags[i].idx = i;
     }
   } else {
-    int nblocks = (int)x[0], nn = (int)x[1], b, got = 0;
+    int nblocks = msh_count(x[0]), nn = msh_count(x[1]), b, got = 0;
     tags = malloc(((size_t)nn + 1) * sizeof *tags);
     if (tags == NULL)
       return dm_err_set(r->e, DM_ENOMEM, "%s: out of memory", r->path);
@@ -360,7 +378,10 @@ static int read_msh(reader *r)
         st = rerr(r, "%s", "node block 'entityDim entityTag parametric numNodes' expected");
         goto done;
       }
-      cnt = (int)x[3];
+      if ((cnt = msh_count(x[3])) < 0) {
+        st = rerr(r, "%s", "node block 'entityDim entityTag parametric numNodes' expected");
+        goto done;
+      }
       if (x[2] != 0) {
         st = rerr(r, "%s", "parametric nodes are not supported");
         goto done;
@@ -376,7 +397,10 @@ static int read_msh(reader *r)
           st = rerr(r, "%s", "node tag expected");
           goto done;
         }
-        tags[got + j].tag = (int)x[0];
+        if ((tags[got + j].tag = msh_tag(x[0])) == INT_MIN) {
+          st = rerr(r, "%s", "node tag expected");
+          goto done;
+        }
         tags[got + j].idx = got + j;
       }
       for (j = 0; j < cnt; j++) {
@@ -415,12 +439,13 @@ static int read_msh(reader *r)
     if (strcmp(r->line, "$Elements") == 0)
       break;
   }
-  if (next_content(r, '\0') != 1 || parse_numbers(r->line, x, 4, &bad) < 1) {
+  if (next_content(r, '\0') != 1 || (k = parse_numbers(r->line, x, 4, &bad)) < (version < 3 ? 1 : 2)
+      || msh_count(x[0]) < 0 || (version >= 3 && msh_count(x[1]) < 0)) {
     st = rerr(r, "%s", "element count expected");
     goto done;
   }
   {
-    int nblocks = version < 3 ? 1 : (int)x[0], b, total = (int)(version < 3 ? x[0] : x[1]);
+    int nblocks = version < 3 ? 1 : msh_count(x[0]), b, total = msh_count(version < 3 ? x[0] : x[1]);
     cape = total + 1;
     etype = malloc((size_t)cape * sizeof *etype);
     enodes = malloc((size_t)cape * 4 * sizeof *enodes);
@@ -438,8 +463,11 @@ static int read_msh(reader *r)
           st = rerr(r, "%s", "element block 'entityDim entityTag elementType numElements' expected");
           goto done;
         }
-        type = (int)x[2];
-        cnt = (int)x[3];
+        type = msh_tag(x[2]);
+        if ((cnt = msh_count(x[3])) < 0) {
+          st = rerr(r, "%s", "element block 'entityDim entityTag elementType numElements' expected");
+          goto done;
+        }
       }
       for (j = 0; j < cnt; j++) {
         int off, dim, c, nnode;
@@ -451,12 +479,12 @@ static int read_msh(reader *r)
           goto done;
         }
         if (version < 3) {
-          if (k < 3) {
+          if (k < 3 || msh_count(x[2]) < 0 || x[2] > 16) {
             st = rerr(r, "%s", "element 'tag type ntags tags... nodes...' expected");
             goto done;
           }
-          type = (int)x[1];
-          off = 3 + (int)x[2];
+          type = msh_tag(x[1]);
+          off = 3 + msh_count(x[2]);
         } else {
           off = 1;
         }
@@ -477,7 +505,8 @@ static int read_msh(reader *r)
           goto done;
         }
         for (c = 0; c < nnode; c++) {
-          int idx = find_tag(tags, r->nv, (int)x[off + c]);
+          int tag = msh_tag(x[off + c]);
+          int idx = tag == INT_MIN ? -1 : find_tag(tags, r->nv, tag);
           if (idx < 0) {
             char d[64];
             snprintf(d, sizeof d, "%.17g", x[off + c]);
