@@ -1,6 +1,6 @@
-/* lagrangian.c -- derive and compile a Lagrangian system; the dm_system
- * callbacks that run the tapes (or their native versions).  See
- * lagrangian.h. */
+/* lagrangian.c -- derive and compile a Lagrangian system (the dm_system
+ * callbacks that run its tapes, or their native versions, are in
+ * lagrangian_eval.c).  See lagrangian.h. */
 #include <config.h>
 #include "expr/lagrangian_impl.h"
 #include "expr/tape.h"
@@ -45,15 +45,6 @@ static void lag_free(dm_system *s)
   s->data = NULL;
 }
 
-/* Inputs are written straight into the tape's register file (its first
- * registers are the inputs), so neither path copies them twice; the tape
- * path of a callback is dm_bundle_tape_scatter. */
-static inline void copy(double *dst, const double *src, size_t k)
-{
-  for (size_t i = 0; i < k; i++)
-    dst[i] = src[i];
-}
-
 /* 1 if any of x[0..k) is NaN or infinite (independent tests, no serial
  * chain: this runs after every evaluation). */
 static int nonfinite(const double *x, size_t k)
@@ -62,131 +53,6 @@ static int nonfinite(const double *x, size_t k)
   for (size_t i = 0; i < k; i++)
     bad |= !(fabs(x[i]) <= DBL_MAX);
   return bad;
-}
-
-/* {==================================================================
- * callbacks
- * =================================================================== */
-
-/* The request mask is passed with L (whose storage is always there) and
- * the arrays the bundle lacks (p->fill) set, so that a request of all the
- * bundle has takes native code's direct path. */
-static int lag_run(const lag_data *d, const double *q, const double *v,
-                   const double *par, unsigned what, dm_lag_out *out, double *w)
-{
-  const size_t n = d->n;
-  const dm_bundle *p = d->sel[what & DM_LAG_ALL];
-  double *o[6] = { &out->L, out->Lq, out->Lv, out->Lvv, out->Lvq, out->Lqq };
-  if (p->scatter != NULL) {
-    const double *in[2] = { q, v };
-    return p->scatter(in, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill, w);
-  }
-  copy(w, q, n);
-  if (p->nin > n)
-    copy(w + n, v, n);
-  return dm_bundle_tape_scatter(p, w, par, o, (what & DM_LAG_ALL) | DM_LAG_L | p->fill);
-}
-
-/* Second derivatives asked for in the other layout than the bundles have:
- * computed into the scratch after the tapes' work, then spread (values ->
- * dense, zeros elsewhere) or gathered (dense -> values). */
-static int lag_convert(const lag_data *d, const double *q, const double *v,
-                       const double *par, unsigned what, dm_lag_out *out, double *w)
-{
-  const dm_csr *pat[3] = { &d->pat.vv, &d->pat.vq, &d->pat.qq };
-  double **dst[3] = { &out->Lvv, &out->Lvq, &out->Lqq };
-  const unsigned bit[3] = { DM_LAG_VV, DM_LAG_VQ, DM_LAG_QQ };
-  dm_lag_out t = *out;
-  double **tp[3] = { &t.Lvv, &t.Lvq, &t.Lqq };
-  double *s = w + d->need;
-  for (int b = 0; b < 3; b++) {
-    *tp[b] = s;
-    s += d->sparse ? pat[b]->nnz : d->n * d->n;
-  }
-  int st = lag_run(d, q, v, par, what, &t, w);
-  out->L = t.L;
-  if (st != 0)
-    return st;
-  for (int b = 0; b < 3; b++)
-    if (what & bit[b]) {
-      if (d->sparse)
-        dm_csr_to_dense(pat[b], *tp[b], *dst[b]);
-      else
-        dm_csr_from_dense(pat[b], *tp[b], *dst[b]);
-    }
-  return 0;
-}
-
-static int lag_eval(void *data, const double *q, const double *v,
-                    const double *par, unsigned what, dm_lag_out *out,
-                    void *work)
-{
-  const lag_data *d = data;
-  int sp = (what & DM_LAG_SPARSE) != 0;
-  if ((what & (DM_LAG_VV | DM_LAG_VQ | DM_LAG_QQ)) && sp != d->sparse)
-    return lag_convert(d, q, v, par, what, out, work);
-  return lag_run(d, q, v, par, what, out, work);
-}
-
-static int force_run(const lag_data *d, const double *q, const double *v,
-                     const double *par, unsigned what, double *F, double *Fq,
-                     double *Fv, double *w)
-{
-  const size_t n = d->n;
-  const dm_bundle *p = (what & (DM_FORCE_Q | DM_FORCE_V)) ? &d->force_all : &d->force;
-  double *o[3] = { F, Fq, Fv };
-  what &= DM_FORCE_F | DM_FORCE_Q | DM_FORCE_V;
-  if (p->scatter != NULL) {
-    const double *in[2] = { q, v };
-    return p->scatter(in, par, o, what, w);
-  }
-  copy(w, q, n);
-  copy(w + n, v, n);
-  return dm_bundle_tape_scatter(p, w, par, o, what);
-}
-
-static int force_eval(void *data, const double *q, const double *v,
-                      const double *par, unsigned what, double *F, double *Fq,
-                      double *Fv, void *work)
-{
-  const lag_data *d = data;
-  int sp = (what & DM_FORCE_SPARSE) != 0;
-  if (!(what & (DM_FORCE_Q | DM_FORCE_V)) || sp == d->sparse)
-    return force_run(d, q, v, par, what, F, Fq, Fv, work);
-  const dm_csr *pat[2] = { &d->pat.fq, &d->pat.fv };
-  double *dst[2] = { Fq, Fv }, *tp[2];
-  double *s = (double *)work + d->need;
-  for (int b = 0; b < 2; b++) {
-    tp[b] = s;
-    s += d->sparse ? pat[b]->nnz : d->n * d->n;
-  }
-  int st = force_run(d, q, v, par, what, F, tp[0], tp[1], work);
-  if (st != 0)
-    return st;
-  for (int b = 0; b < 2; b++)
-    if (what & (b == 0 ? DM_FORCE_Q : DM_FORCE_V)) {
-      if (d->sparse)
-        dm_csr_to_dense(pat[b], tp[b], dst[b]);
-      else
-        dm_csr_from_dense(pat[b], tp[b], dst[b]);
-    }
-  return 0;
-}
-
-static int constr_eval(void *data, const double *q, const double *par,
-                       unsigned what, double *g, double *G, double *H,
-                       void *work)
-{
-  const lag_data *d = data;
-  const dm_bundle *p = (what & DM_CONSTR_D2G) ? &d->constr_all : &d->constr;
-  double *o[3] = { g, G, H };
-  if (p->scatter != NULL) {
-    const double *in[1] = { q };
-    return p->scatter(in, par, o, what, work);
-  }
-  double *w = work;
-  copy(w, q, d->n);
-  return dm_bundle_tape_scatter(p, w, par, o, what);
 }
 
 /* {==================================================================
@@ -773,9 +639,9 @@ int dm_lagrangian_compile(dm_expr_ctx *ctx, const dm_lagrangian_spec *sp,
   sys->mass = (flags & DM_SYS_SEPARABLE) ? d->mass : NULL;
   d->pat.mass = (flags & DM_SYS_SEPARABLE) ? d->pmass : NULL;
   sys->pattern = &d->pat;
-  sys->lagrangian = lag_eval;
-  sys->force = sp->force ? force_eval : NULL;
-  sys->constraints = sp->m ? constr_eval : NULL;
+  sys->lagrangian = dm_lag__eval;
+  sys->force = sp->force ? dm_lag__force_eval : NULL;
+  sys->constraints = sp->m ? dm_lag__constr_eval : NULL;
   sys->data = d;
   sys->work_size = need * sizeof(double);
   sys->free_data = lag_free;

@@ -1,6 +1,6 @@
-/* lagrangian_impl.h -- internals shared by lagrangian.c (building, the
- * callbacks) and lagrangian_sparse.c (patterns, the outputs of the sparse
- * layout).  Not a public header. */
+/* lagrangian_impl.h -- internals shared by lagrangian.c (building),
+ * lagrangian_eval.c (the callbacks) and lagrangian_sparse.c (patterns, the
+ * outputs of the sparse layout).  Not a public header. */
 #ifndef DM_LAGRANGIAN_IMPL_H
 #define DM_LAGRANGIAN_IMPL_H
 
@@ -67,5 +67,14 @@ int dm_lag__detect_structure(lag_builder *b, lag_data *d, const dm_expr *Lv,
                              size_t nmout, const dm_expr *mout, unsigned *flags);
 /* The bundle for each request (lagrangian.c). */
 void dm_lag__select(lag_data *d);
+/* The dm_system callbacks (lagrangian_eval.c); data is the lag_data. */
+int dm_lag__eval(void *data, const double *q, const double *v,
+                 const double *par, unsigned what, dm_lag_out *out, void *work);
+int dm_lag__force_eval(void *data, const double *q, const double *v,
+                       const double *par, unsigned what, double *F, double *Fq,
+                       double *Fv, void *work);
+int dm_lag__constr_eval(void *data, const double *q, const double *par,
+                        unsigned what, double *g, double *G, double *H,
+                        void *work);
 
 #endif

@@ -3,7 +3,7 @@
  * on their structural pattern only (dm_expr_hessian_sparse: the cost of the
  * gradient's DAG, not n times it) and compiled as values on the patterns,
  * so a chain of n masses has O(n) outputs instead of 3 n^2.  The dense
- * layout and the callbacks are in lagrangian.c. */
+ * layout is in lagrangian.c, the callbacks in lagrangian_eval.c. */
 #include <config.h>
 #include "expr/lagrangian_impl.h"
 #include "expr/tape.h"
