@@ -1,6 +1,7 @@
 /* lagrangian_impl.h -- internals shared by lagrangian.c (building),
- * lagrangian_eval.c (the callbacks) and lagrangian_sparse.c (patterns, the
- * outputs of the sparse layout).  Not a public header. */
+ * lagrangian_check.c (the checks of the description), lagrangian_eval.c
+ * (the callbacks) and lagrangian_sparse.c (patterns, the outputs of the
+ * sparse layout).  Not a public header. */
 #ifndef DM_LAGRANGIAN_IMPL_H
 #define DM_LAGRANGIAN_IMPL_H
 
@@ -65,6 +66,11 @@ int dm_lag__compile_bundle(lag_builder *b, dm_bundle *p, size_t nout, const dm_e
 int dm_lag__detect_structure(lag_builder *b, lag_data *d, const dm_expr *Lv,
                              size_t nvv, const dm_expr *Lvv, int lvq_zero,
                              size_t nmout, const dm_expr *mout, unsigned *flags);
+/* The context's error (out of memory, or why a derivative failed) as
+ * "what: message" in b->err; returns its status (lagrangian.c). */
+int dm_lag__ctx_fail(lag_builder *b, const char *what);
+/* The description checked before anything is derived (lagrangian_check.c). */
+int dm_lag__check_spec(lag_builder *b);
 /* The bundle for each request (lagrangian.c). */
 void dm_lag__select(lag_data *d);
 /* The dm_system callbacks (lagrangian_eval.c); data is the lag_data. */

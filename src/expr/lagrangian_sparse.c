@@ -87,13 +87,6 @@ static int oom(lag_builder *b)
   return dm_err_set(b->err, DM_ENOMEM, "out of memory");
 }
 
-static int ctx_fail(lag_builder *b, const char *what)
-{
-  const dm_err *e = dm_expr_ctx_err(b->ctx);
-  return dm_err_set(b->err, e->status ? e->status : DM_EFAILED, "%s: %s",
-                    what, e->msg[0] ? e->msg : "cannot build the derivatives");
-}
-
 /* Lvv (upper), Lvq (transposed from the (q_i, v_j) entries) and Lqq
  * (upper) from the upper triangle of the Hessian in (q, v), with their
  * patterns. */
@@ -129,7 +122,7 @@ int dm_lag__build_sparse(lag_builder *b, lag_data *d, unsigned *flags)
   dm_expr *out = NULL, *ow = NULL, *mout = NULL, *sep = NULL;
   int s;
   if (dm_expr_hessian_sparse(b->ctx, sp->L, 2 * n, b->in, &H, b->err) != DM_OK) {
-    s = ctx_fail(b, "L");
+    s = dm_lag__ctx_fail(b, "L");
     goto done;
   }
   if ((s = split_hessian(d, &H, blk)) != DM_OK) {
@@ -147,7 +140,7 @@ int dm_lag__build_sparse(lag_builder *b, lag_data *d, unsigned *flags)
   }
   out[0] = sp->L;
   if (dm_expr_grad(b->ctx, sp->L, 2 * n, b->in, out + 1, b->err) != DM_OK) {
-    s = ctx_fail(b, "L");
+    s = dm_lag__ctx_fail(b, "L");
     goto done;
   }
   dm_expr *o = out + 1 + 2 * n;
@@ -211,7 +204,7 @@ int dm_lag__build_force_sparse(lag_builder *b, lag_data *d)
   for (int k = 0; k < 2 && s == DM_OK; k++)
     if (dm_expr_jacobian_sparse(b->ctx, n, sp->force, n, b->in + k * n, &J[k], b->err)
         != DM_OK)
-      s = ctx_fail(b, "force");
+      s = dm_lag__ctx_fail(b, "force");
   if (s != DM_OK)
     goto done;
   size_t nall = n + J[0].nnz + J[1].nnz, mx = J[0].nnz > J[1].nnz ? J[0].nnz : J[1].nnz;
