@@ -58,6 +58,7 @@ void dm_routh_release_progs(dm_routh *red)
     prog_free(ps[i]);
   dm_bundle_free(&red->stage_r);
   dm_bundle_free(&red->stage_j);
+  dm_csr_free(&red->upat);
 }
 
 /* {==== RSPRK stage programs ============================================= */
@@ -89,6 +90,50 @@ static int compile_stage(dm_bundle *p, const dm_bundle_src *src, const dm_expr *
     o += len;
   }
   return dm_bundle_compile(p, src, (size_t)(o - out), out, 2 * s, blk, nb, 1, e);
+}
+
+/* The pattern of a stage block of the RSPRK Newton matrix (rsprk.c:
+ * d_ik Rvv + h a_ik (Rvx + K) - h at_ik E - h^2 sum at a D, E = Rxv - B^T
+ * + Fv + K, D = Rxx - dib + Fx + dkv): entry (a, c) unless every term
+ * that lands there is the constant 0 -- indexed as rsprk.c reads the
+ * stage arrays.  R: the rewritten Lagrangian outputs (L, Lq, Lv, Lvv and
+ * Lqq upper triangles, Lvq full), F: F, Fq, Fv (or NULL), G: muA, K, B,
+ * kv, ib, dkv, dib (or NULL). */
+static int stage_pattern(dm_expr_ctx *ctx, dm_routh *red, const dm_expr *R, const dm_expr *F,
+                         const dm_expr *G)
+{
+  size_t s = red->s, ss = s * s, tri = s * (s + 1) / 2, a, c, nnz = 0;
+  const dm_expr *vv = R + 1 + 2 * s, *vq = vv + tri, *qq = vq + ss;
+  double z;
+  dm_csr *U = &red->upat;
+  dm_csr_free(U);
+  uint32_t *cols = malloc((ss + 1) * sizeof *cols);
+  if (cols == NULL || dm_csr_alloc(U, s, s, 0) != DM_OK) {
+    free(cols);
+    return DM_ENOMEM;
+  }
+#define NZ(x) (!dm_expr_is_const(ctx, (x), &z) || z != 0)
+  for (a = 0; a < s; a++) {
+    U->rowptr[a] = nnz;
+    for (c = 0; c < s; c++) {
+      size_t lo = a < c ? a : c, hi = a < c ? c : a;
+      size_t t = lo * (2 * s - lo + 1) / 2 + (hi - lo), ac = a * s + c, ca = c * s + a;
+      int on = NZ(vv[t]) || NZ(qq[t]) || NZ(vq[ac]) || NZ(vq[ca]);
+      if (!on && F != NULL)
+        on = NZ(F[s + ac]) || NZ(F[s + ss + ac]);
+      if (!on && G != NULL)
+        on = NZ(G[s + ac]) || NZ(G[s + ss + ca]) || NZ(G[3 * s + 2 * ss + ac])
+             || NZ(G[3 * s + 3 * ss + ac]);
+      if (on)
+        cols[nnz++] = (uint32_t)c;
+    }
+  }
+#undef NZ
+  U->rowptr[s] = nnz;
+  free(U->col);
+  U->col = cols;
+  U->nnz = nnz;
+  return DM_OK;
 }
 
 /* The programs of an RSPRK stage, one per request kind (gradient: stage_r;
@@ -143,6 +188,8 @@ static int compile_stages(dm_expr_ctx *ctx, dm_routh *red, const dm_routh_spec *
     }
     st = compile_stage(&red->stage_r, &src, from, s, out, e);
   }
+  if (st == DM_OK && stage_pattern(ctx, red, Rw, nF ? F : NULL, nG ? Gj : NULL) != DM_OK)
+    st = dm_err_set(e, DM_ENOMEM, "out of memory");
   if (st == DM_OK) {         /* everything */
     const dm_expr *from[DM_RS_NARR] = {Rw + 1, Rw + 1 + s, Rw + 1 + 2 * s, Rw + 1 + 2 * s + tri,
                                        Rw + 1 + 2 * s + tri + ss};

@@ -8,6 +8,7 @@
 #include "core/newton.h"
 #include "integrators/galerkin.h"
 #include "expr/tape.h"
+#include "core/sparse.h"
 
 /* A compiled bundle of outputs: tape, and native code when available. */
 typedef struct dm_rprog {
@@ -78,6 +79,8 @@ struct dm_routh {
   dm_rprog gyro_r;                 /* (x, xd) -> muA, kv, ib */
   dm_bundle stage_r, stage_j;      /* (x, xd) -> the arrays of an RSPRK stage
                                       (dm_rstage_arr): gradient / all */
+  dm_csr upat;                     /* s x s: the structural pattern of a stage
+                                      block of the RSPRK Newton matrix */
   dm_rprog thd;                    /* (x, xd) -> thetadot (r) */
   dm_rprog info;                   /* (x, xd) -> everything of dm_routh_vals */
   size_t nwork;                    /* max tape work over the programs */
@@ -171,8 +174,13 @@ double dm_rnorm_inf(const double *x, size_t n);
  * 2.5.14 on T*S for any PRK tableau, constraints with Lobatto-type
  * tableaus (multipliers at every stage) or one stage. */
 typedef struct dm_rsprk dm_rsprk;
+/* linear: DM_LINEAR_AUTO, _DENSE or _SPARSE (core/sparse.h): how the
+ * Newton matrices are factored (auto: by size and sparsity, rsprk.c) */
 int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, int simplified,
-                   dm_rsprk **out, dm_err *e);
+                   int linear, dm_rsprk **out, dm_err *e);
+/* DM_LINEAR_DENSE or DM_LINEAR_SPARSE as chosen; *nnz: entries of the
+ * sparse Newton matrix (0 when dense) */
+int dm_rsprk_linear(const dm_rsprk *P, size_t *nnz);
 void dm_rsprk_free(dm_rsprk *P);
 void dm_rsprk_reset(dm_rsprk *P);
 /* (x0, s0) -> (x1, s1); dtheta (r, may be NULL) = h sum_j b_j Thetadot_j. */

@@ -41,7 +41,7 @@ static const dm_integrator_type rsprk_type, dr_type, classical_type, ode_type;
 static const char *const routh_options[] = {"stages", "h", "tol", "maxiter", "simplified", NULL};
 /* RSPRK and classical also take a user tableau (method prk) */
 static const char *const tableau_options[] = {"stages", "h", "tol", "maxiter", "simplified",
-                                              "tableau", NULL};
+                                              "tableau", "linear", "iteration", NULL};
 static const char *const routh_kinds[] = {DM_ROUTH_KIND, NULL};
 static const char *const rsprk_names[] = {"gauss", "midpoint", "lobatto", "trapezoid", "prk", NULL};
 static const char *const ode_names[] = {"rk4", NULL};
@@ -165,8 +165,21 @@ static int rsprk_alloc(dm_integrator *I, dm_err *e)
   dm_tableau *t = NULL;
   rinteg *R;
   int st;
+  int linear = dm_linear_mode_parse(I->opt.linear);
+  const char *it = I->opt.iteration;
+  if (linear < 0)
+    return dm_err_set(e, DM_EINVAL, "option 'linear' must be \"auto\", \"dense\" or "
+                      "\"sparse\", got \"%s\"", I->opt.linear);
+  if (it[0] != '\0' && strcmp(it, "auto") != 0 && strcmp(it, "newton") != 0
+      && strcmp(it, "fixed") != 0)
+    return dm_err_set(e, DM_EINVAL, "option 'iteration' must be \"auto\", \"newton\" or "
+                      "\"fixed\", got \"%s\"", it);
   if ((st = rinteg_new(I, K_RSPRK, &R, e)) != DM_OK)
     return st;
+  if (!R->red->general && strcmp(it, "fixed") == 0)
+    return dm_err_set(e, DM_EINVAL, "iteration = \"fixed\" needs a separable Lagrangian "
+                      "1/2 v^T M v - V(q) without forces or constraints: the reduced stage "
+                      "equations (RSPRK) carry the connection terms and are solved by Newton");
   if (R->red->general) {
     /* no connection, no RSPRK stage programs: with the momentum shift the
      * identity, RSPRK is the same method on the classical Routhian */
@@ -177,8 +190,10 @@ static int rsprk_alloc(dm_integrator *I, dm_err *e)
   }
   if ((st = make_tableau(fam, &I->opt, &t, e)) != DM_OK)
     return st;
-  st = dm_rsprk_alloc(R->red, t, I->opt.tol, I->opt.maxiter, I->opt.simplified, &R->P, e);
+  st = dm_rsprk_alloc(R->red, t, I->opt.tol, I->opt.maxiter, I->opt.simplified, linear, &R->P,
+                      e);
   if (st == DM_OK) {
+    I->stats.linear = dm_rsprk_linear(R->P, &I->stats.nnz);
     I->order = t->order;
     I->stages = (int)t->s;
     if (t->flags & DM_TAB_SYMMETRIC)

@@ -121,6 +121,10 @@ void dm_rsprk_free(dm_rsprk *P)
     return;
   free(P->Jm);
   free(P->work);
+  dm_csr_free(&P->J);
+  free(P->jblk);
+  free(P->Jv);
+  dm_splu_free(P->slu);
   dm_rlu_free(&P->lu);
   dm_rlu_free(&P->lu_small);
   dm_tableau_free(P->tab);
@@ -136,11 +140,73 @@ void dm_rsprk_reset(dm_rsprk *P)
   memset(P->cp, 0, P->d * sizeof(double));
 }
 
+/* Dense or sparse Newton matrices (linear = DM_LINEAR_AUTO), the rule of
+ * the unreduced engine (prk_engine.c, doc/scale.md §3): dense up to
+ * RS_SPARSE_MIN unknowns and when a stage block would be more than a
+ * quarter full (always with constraints, whose curvature terms fill the
+ * blocks), sparse above or beyond RS_DENSE_MAX unknowns. */
+#define RS_SPARSE_MIN 48
+#define RS_DENSE_MAX 2048
+
+static int want_sparse(const dm_rsprk *P, int linear)
+{
+  double d = (double)P->d;
+  if (linear != DM_LINEAR_AUTO)
+    return linear == DM_LINEAR_SPARSE;
+  if (P->N <= RS_SPARSE_MIN)
+    return 0;
+  if (P->N > RS_DENSE_MAX)
+    return 1;
+  return P->m == 0 && (double)P->red->upat.nnz <= 0.25 * d * d;
+}
+
+/* J's pattern: row (i, a) holds stage blocks (i, 0) .. (i, S-1) of row a
+ * of upat; with constraints every entry (the multiplier code fills the
+ * dense matrix, whose values are gathered). */
+static int sparse_setup(dm_rsprk *P, dm_err *e)
+{
+  const dm_csr *U = &P->red->upat;
+  const size_t d = P->d, S = P->S, nU = U->nnz;
+  size_t i, k, a, q, n = 0;
+  int st;
+  if (P->m > 0) {
+    if (dm_csr_full(&P->J, P->N, P->N) != DM_OK)
+      return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+  } else {
+    if (U->nrow != d)
+      return dm_err_set(e, DM_EINVAL, "RSPRK: the reduced system has no stage pattern");
+    if (dm_csr_alloc(&P->J, P->N, P->N, S * S * nU) != DM_OK
+        || (P->jblk = malloc((S * S * nU + 1) * sizeof *P->jblk)) == NULL)
+      return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+    for (i = 0; i < S; i++)
+      for (a = 0; a < d; a++) {
+        P->J.rowptr[i * d + a] = n;
+        for (k = 0; k < S; k++)
+          for (q = U->rowptr[a]; q < U->rowptr[a + 1]; q++) {
+            P->jblk[(i * S + k) * nU + q] = (uint32_t)n;
+            P->J.col[n++] = (uint32_t)(k * d + U->col[q]);
+          }
+      }
+    P->J.rowptr[P->N] = n;
+  }
+  if ((P->Jv = calloc(P->J.nnz + 1, sizeof *P->Jv)) == NULL)
+    return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
+  if ((st = dm_splu_alloc(&P->J, &P->slu, e)) != DM_OK)
+    return st;
+  return DM_OK;
+}
+
+int dm_rsprk_linear(const dm_rsprk *P, size_t *nnz)
+{
+  *nnz = P->sparse ? P->J.nnz : 0;
+  return P->sparse ? DM_LINEAR_SPARSE : DM_LINEAR_DENSE;
+}
+
 int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, int simplified,
-                   dm_rsprk **out, dm_err *e)
+                   int linear, dm_rsprk **out, dm_err *e)
 {
   dm_rsprk *P = calloc(1, sizeof *P);
-  size_t d = red->s, S = t->s, m = red->m, dd = d * d, Sd = S * d, tot, i, j, nsm, nout;
+  size_t d = red->s, S = t->s, m = red->m, dd = d * d, Sd = S * d, tot, i, j, nsm, nout, mat;
   double *p;
   int st;
   *out = NULL;
@@ -169,19 +235,26 @@ int dm_rsprk_alloc(dm_routh *red, const dm_tableau *t, double tol, int maxiter, 
     return st;
   }
   P->N = Sd + (m ? P->nK * m + m : 0);
+  P->sparse = want_sparse(P, linear);
+  if (P->sparse && (st = sparse_setup(P, e)) != DM_OK) {
+    dm_rsprk_free(P);
+    return st;
+  }
   nsm = d + m;
   nout = red->gyro_r.nout > red->info.nout ? red->gyro_r.nout : red->info.nout;
-  tot = P->N * P->N + 2 * P->N + P->N * 2 * d + 8 * Sd + 11 * S * dd + S + 2 * d + 2 * dd
+  mat = P->sparse && m == 0 ? 0 : P->N * P->N;   /* the dense Newton matrix */
+  tot = mat + 2 * P->N + P->N * 2 * d + 8 * Sd + 11 * S * dd + S + 2 * d + 2 * dd
         + (S + 2) * (m + m * d + m * dd) + 6 * d + P->r + Sd + P->N + 2 * d + S * S + 2 * d
         + nsm * nsm + nsm + 2 * d + nout + red->nwork + red->r * red->r + 8;
   P->Jm = calloc(tot, sizeof(double));
   P->work = red->rsys.work_size ? malloc(red->rsys.work_size) : NULL;
-  if (P->Jm == NULL || (red->rsys.work_size && P->work == NULL) || dm_rlu_init(&P->lu, P->N)
+  if (P->Jm == NULL || (red->rsys.work_size && P->work == NULL)
+      || (!P->sparse && dm_rlu_init(&P->lu, P->N) != 0)
       || dm_rlu_init(&P->lu_small, d + m)) {
     dm_rsprk_free(P);
     return dm_err_set(e, DM_ENOMEM, "RSPRK: out of memory");
   }
-  p = P->Jm + P->N * P->N;
+  p = P->Jm + mat;
 #define TAKE(ptr, cnt) do { (ptr) = p; p += (cnt); } while (0)
   TAKE(P->R, P->N); TAKE(P->X, P->N); TAKE(P->rhs, P->N * 2 * d);
   TAKE(P->Xs, Sd); TAKE(P->Lq, Sd); TAKE(P->Lv, Sd); TAKE(P->F, Sd); TAKE(P->Sdot, Sd);
@@ -368,6 +441,31 @@ static int assemble(dm_rsprk *P, double h, const double *x0, const double *s0, i
     const double *restrict Lvq = P->Lvq, *restrict gK = P->gK, *restrict E = P->E;
     const double *restrict Lvv = P->Lvv, *restrict D = P->D;
     double *restrict Jm = P->Jm, cj[DM_TABLEAU_SMAX];
+    if (P->sparse && P->m == 0) {
+      /* the same entries with the same arithmetic, on the pattern */
+      const dm_csr *U = &P->red->upat;
+      const size_t nU = U->nnz;
+      double *restrict Jv = P->Jv;
+      for (i = 0; i < S; i++)
+        for (k = 0; k < S; k++) {
+          const double hak = h * A[i * S + k], hatk = h * At[i * S + k];
+          const uint32_t *pl = P->jblk + (i * S + k) * nU;
+          for (j = 0; j < S; j++)
+            cj[j] = h * h * At[i * S + j] * A[j * S + k];
+          for (a = 0; a < d; a++)
+            for (size_t q = U->rowptr[a]; q < U->rowptr[a + 1]; q++) {
+              const size_t ac = a * d + U->col[q];
+              double v = hak * (Lvq[i * dd + ac] + gK[i * dd + ac]) - hatk * E[k * dd + ac];
+              if (i == k)
+                v += Lvv[i * dd + ac];
+              for (j = 0; j < S; j++)
+                v -= cj[j] * D[j * dd + ac];
+              Jv[pl[q]] = v;
+            }
+        }
+      P->lvv_norm = norm_inf(P->Lvv, S * dd);
+      return DM_OK;
+    }
     if (N > P->Sd)
       memset(Jm, 0, N * N * sizeof(double));
     for (i = 0; i < S; i++)
@@ -389,8 +487,10 @@ static int assemble(dm_rsprk *P, double h, const double *x0, const double *s0, i
       }
     P->lvv_norm = norm_inf(P->Lvv, S * dd);   /* Lvv changes only with the Jacobian */
   }
-  if (P->m)
-    return dm_rsprk_constr_assemble(P, h, x0, jac, e);
+  if (P->m && (st = dm_rsprk_constr_assemble(P, h, x0, jac, e)) != DM_OK)
+    return st;
+  if (jac && P->sparse)            /* constrained: gathered from the dense matrix */
+    dm_csr_from_dense(&P->J, P->Jm, P->Jv);
   return DM_OK;
 }
 
@@ -442,14 +542,19 @@ static int newton(dm_rsprk *P, double h, const double *x0, const double *s0, dm_
                                    "(h = %g, iteration %d)", h, it), e);
     if (jac) {
       njac++;
-      st = dm_rlu_factor(&P->lu, P->Jm, N);
+      st = P->sparse ? dm_splu_factor(P->slu, P->Jv, NULL) : dm_rlu_factor(&P->lu, P->Jm, N);
+      if (st == DM_ENOMEM)
+        return dm_err_set(e, st, "RSPRK: out of memory");
       if (st != DM_OK)
         return explain(P, dm_err_set(e, st == DM_EDOM ? DM_EDOM : DM_ESINGULAR,
                                      "RSPRK: singular Newton matrix of the stage equations (h = %g)%s",
                                      h, P->m ? "; the constraint gradients may be dependent"
                                      : "; try a smaller step"), e);
     }
-    dm_rlu_solve(&P->lu, P->Jm, N, P->R);
+    if (P->sparse)
+      dm_splu_solve(P->slu, P->R, 1, NULL);
+    else
+      dm_rlu_solve(&P->lu, P->Jm, N, P->R);
     {
       /* X -= R; max |R| and max |X| of the velocities on the way (NaN or
        * Inf in either makes dn NaN: the test below catches it) */
@@ -685,7 +790,8 @@ int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0,
     return st;
   if ((st = assemble(P, h, x0, s0, 1, e)) != DM_OK)
     return st;
-  if (dm_rlu_factor(&P->lu, P->Jm, Sd) != DM_OK)
+  if ((P->sparse ? dm_splu_factor(P->slu, P->Jv, NULL) : dm_rlu_factor(&P->lu, P->Jm, Sd))
+      != DM_OK)
     return dm_err_set(e, DM_ESINGULAR, "RSPRK Jacobian: singular stage matrix (h = %g)", h);
   for (c = 0; c < N2; c++) {
     double *dV = P->rhs + c * Sd;
@@ -701,7 +807,10 @@ int dm_rsprk_jacobian(dm_rsprk *P, double h, const double *x0, const double *s0,
         }
         dV[i * d + a] = -v;
       }
-    dm_rlu_solve(&P->lu, P->Jm, Sd, dV);
+    if (P->sparse)
+      dm_splu_solve(P->slu, dV, 1, NULL);
+    else
+      dm_rlu_solve(&P->lu, P->Jm, Sd, dV);
     for (j = 0; j < S; j++)
       for (a = 0; a < d; a++) {
         double acc = 0.0;

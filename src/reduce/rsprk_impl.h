@@ -32,6 +32,14 @@ struct dm_rsprk {
   double *hV, *hx, *hq1, *hp1, *Ex, *cq, *cp;
   double sing_ref;
   double lvv_norm;               /* max |Lvv| over the stages, set with the Jacobian */
+  /* sparse Newton matrices (linear = sparse): the pattern J (stage
+   * blocks on red->upat, every entry with constraints), the place in J of
+   * entry p of stage block (i, k) (unconstrained), the values, KLU */
+  int sparse;
+  dm_csr J;
+  uint32_t *jblk;                /* S*S*nnz(upat) */
+  double *Jv;                    /* nnz(J) */
+  dm_splu *slu;
   dm_rlu lu, lu_small;           /* N; d + m (velocity / projection) */
   double *small;                 /* (d + m)^2 + (d + m) */
   double *tin, *tout, *twork;    /* program input (2d), outputs, tape work */
