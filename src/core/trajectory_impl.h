@@ -1,6 +1,7 @@
 /* trajectory_impl.h -- the representation of a trajectory, shared by the
  * files of src/core that implement trajectory.h (trajectory.c: columns,
- * samples, slicing; trajectory_meta.c: metadata).  Private to src/core. */
+ * samples, slicing; trajectory_columns.c: extra columns; trajectory_meta.c:
+ * metadata).  Private to src/core. */
 #ifndef DM_TRAJECTORY_IMPL_H
 #define DM_TRAJECTORY_IMPL_H
 
@@ -38,5 +39,13 @@ struct dm_traj {
 
 /* A malloc'ed copy of s (non-NULL), or NULL when out of memory. */
 char *dm_traj__dupstr(const char *s);
+/* 1 if s is a valid column name (see trajectory.h). */
+int dm_traj__valid_name(const char *s);
+/* The DM_EINVAL error for the invalid (or missing) `what` name s. */
+int dm_traj__bad_name(dm_err *e, const char *what, const char *s);
+/* Keep the name index up to date: column j (the last one) was just
+ * appended; or the column list changed otherwise. */
+void dm_traj__index_added(dm_traj *tr, size_t j);
+void dm_traj__index_rebuild(dm_traj *tr);
 
 #endif
