@@ -127,6 +127,15 @@ const char *dm_checkcstring(lua_State *L, int arg);
  * `what` starts the message "<what>: NUL byte at position k of "...""). */
 const char *dm_tocstring(lua_State *L, int idx, const char *what);
 
+/* 1 when the table at index t has a key that is not among keys (a
+ * NULL-terminated list of strings), that key (the first one lua_next
+ * gives) pushed; else 0, nothing pushed. */
+int dm_unknownkey(lua_State *L, int t, const char *const *keys);
+/* Raise "<what>: unknown <noun> 'k' (<noun>s: <list>)" ([k] for a key that
+ * is not a string) for such a key of the table at t; return if none. */
+void dm_checkkeys(lua_State *L, int t, const char *const *keys, const char *what,
+                  const char *noun, const char *list);
+
 /* Option value from the table at index t: number field `key` or default;
  * raises "bad argument #t to 'f' (field 'key': number expected, got X)". */
 double dm_optnumberfield(lua_State *L, int t, const char *key, double def);

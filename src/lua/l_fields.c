@@ -80,15 +80,6 @@ static int fail(lua_State *L, const char *what, int st, const dm_err *e)
   return luaL_error(L, "%s: %s", what, m[0] ? m : dm_strstatus(st));
 }
 
-/* "unknown field 'x'" / "unknown field [1]" for the key at -2 */
-static void unknown_key(lua_State *L, const char *what, const char *noun, const char *list)
-{
-  int str = lua_type(L, -2) == LUA_TSTRING;
-  const char *k = luaL_tolstring(L, -2, NULL);
-  luaL_error(L, "%s: unknown %s %s%s%s (%ss: %s)", what, noun, str ? "'" : "[", k, str ? "'" : "]",
-             noun, list);
-}
-
 static int schrod_gc(lua_State *L)
 {
   lschrod *u = luaL_checkudata(L, 1, SCHROD_MT);
@@ -127,16 +118,7 @@ static int l_schrodinger(lua_State *L)
   int st;
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    const char *const *k = schrod_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      unknown_key(L, "dm.schrodinger", "field", "K, hbar, m, V, samples");
-    lua_pop(L, 1);
-  }
+  dm_checkkeys(L, 1, schrod_keys, "dm.schrodinger", "field", "K, hbar, m, V, samples");
   K = dm_optintegerfield(L, 1, "K", 16);
   hbar = dm_optnumberfield(L, 1, "hbar", 1.0);
   m = dm_optnumberfield(L, 1, "m", 1.0);
@@ -271,16 +253,7 @@ static int s_run(lua_State *L)
   if (w0->N != N || (wave_owner(L, 2), lua_rawequal(L, -1, 1)) == 0)
     return luaL_argerror(L, 2, "a wave of this Schrodinger integrator expected");
   lua_pop(L, 1);
-  lua_pushnil(L);
-  while (lua_next(L, 3) != 0) {
-    const char *const *k = run_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      unknown_key(L, "run", "option", "method, dt, t, steps, every, start");
-    lua_pop(L, 1);
-  }
+  dm_checkkeys(L, 3, run_keys, "run", "option", "method, dt, t, steps, every, start");
   int mi = pick(L, 3, "method", methods, "milne, cn or exact");
   int si = pick(L, 3, "start", starts, "exact or cn");
   double dt = dm_optnumberfield(L, 3, "dt", NAN);
@@ -536,16 +509,7 @@ static int l_msfem(lua_State *L)
   dm_err e;
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    const char *const *k = msfem_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      unknown_key(L, "dm.msfem", "field", "a, f, eps, N, Phi, method, tol");
-    lua_pop(L, 1);
-  }
+  dm_checkkeys(L, 1, msfem_keys, "dm.msfem", "field", "a, f, eps, N, Phi, method, tol");
   lua_Integer N = dm_optintegerfield(L, 1, "N", 0);
   double eps = dm_optnumberfield(L, 1, "eps", NAN), tol = dm_optnumberfield(L, 1, "tol", 0);
   int mi = 0;

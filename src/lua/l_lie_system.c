@@ -172,17 +172,9 @@ int dm_lua_lie_system(lua_State *L)
   const char *name;
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    const char *const *k = keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      return luaL_error(L, "dm.system: unknown field %s for a system on a Lie group (fields: "
-                        "space, L, force, params, name, native)", dm_tolstring(L, -2, NULL));
-    lua_pop(L, 1);
-  }
+  if (dm_unknownkey(L, 1, keys))
+    return luaL_error(L, "dm.system: unknown field %s for a system on a Lie group (fields: "
+                      "space, L, force, params, name, native)", dm_tolstring(L, -1, NULL));
   lua_getfield(L, 1, "space");                              /* 2 */
   if ((G = dm_lua_togroup(L, 2)) == NULL)
     return luaL_error(L, "dm.system: field 'space' must be a Lie group (dm.lie.SO3(), "

@@ -586,19 +586,11 @@ static void check_fields(lua_State *L, int t)
 {
   static const char *const known[] = {"name", "coords", "params", "L", "force",
                                       "constraints", "native", NULL};
-  lua_pushnil(L);
-  while (lua_next(L, t) != 0) {
-    int i = 0;
-    lua_pop(L, 1);
-    if (lua_type(L, -1) == LUA_TSTRING)
-      for (; known[i] != NULL && strcmp(known[i], lua_tostring(L, -1)) != 0; i++)
-        ;
-    if (lua_type(L, -1) != LUA_TSTRING || known[i] == NULL) {
-      int str = lua_type(L, -1) == LUA_TSTRING;
-      const char *key = dm_tolstring(L, -1, NULL);
-      luaL_error(L, "dm.system: unknown field %s%s%s (fields: name, coords, params, L, "
-                 "force, constraints, native)", str ? "'" : "[", key, str ? "'" : "]");
-    }
+  if (dm_unknownkey(L, t, known)) {
+    int str = lua_type(L, -1) == LUA_TSTRING;
+    const char *key = dm_tolstring(L, -1, NULL);
+    luaL_error(L, "dm.system: unknown field %s%s%s (fields: name, coords, params, L, "
+               "force, constraints, native)", str ? "'" : "[", key, str ? "'" : "]");
   }
 }
 

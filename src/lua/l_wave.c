@@ -118,16 +118,10 @@ static int check_adapt(lua_State *L, int t, double *alpha)
   if (!lua_istable(L, t))
     luaL_error(L, "dm.wave: adapt must be a table {monitor = \"arclength\", alpha = ...}, got %s",
                luaL_typename(L, t));
-  lua_pushnil(L);
-  while (lua_next(L, t) != 0) {
-    const char *const *k = adapt_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      luaL_error(L, "dm.wave: unknown field %s%s%s of adapt (fields: monitor, alpha, rule)",
-                 key ? "'" : "[", luaL_tolstring(L, -2, NULL), key ? "'" : "]");
-    lua_pop(L, 1);
+  if (dm_unknownkey(L, t, adapt_keys)) {
+    int str = lua_type(L, -1) == LUA_TSTRING;
+    luaL_error(L, "dm.wave: unknown field %s%s%s of adapt (fields: monitor, alpha, rule)",
+               str ? "'" : "[", luaL_tolstring(L, -1, NULL), str ? "'" : "]");
   }
   if (lua_getfield(L, t, "monitor") != LUA_TNIL
       && (lua_type(L, -1) != LUA_TSTRING || strcmp(lua_tostring(L, -1), "arclength") != 0))
@@ -164,17 +158,8 @@ static int l_wave(lua_State *L)
   int st;
   luaL_checktype(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
-  lua_pushnil(L);
-  while (lua_next(L, 1) != 0) {
-    const char *const *k = wave_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      luaL_error(L, "dm.wave: unknown field %s%s%s (fields: N, length, x0, periodic, c, dt, V, "
-                 "mesh, adapt)", key ? "'" : "[", luaL_tolstring(L, -2, NULL), key ? "'" : "]");
-    lua_pop(L, 1);
-  }
+  dm_checkkeys(L, 1, wave_keys, "dm.wave", "field",
+               "N, length, x0, periodic, c, dt, V, mesh, adapt");
   double c = dm_optnumberfield(L, 1, "c", 1.0), dt = dm_optnumberfield(L, 1, "dt", NAN);
   if (!isfinite(dt) || dt == 0.0)
     luaL_error(L, "dm.wave: dt must be a finite non-zero number (the time step)");
@@ -369,17 +354,7 @@ static int w_run(lua_State *L)
   luaL_checktype(L, 2, LUA_TTABLE);
   luaL_checktype(L, 3, LUA_TTABLE);
   lua_settop(L, 3);
-  lua_pushnil(L);
-  while (lua_next(L, 3) != 0) {
-    const char *const *k = run_keys;
-    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
-    while (key && *k && strcmp(*k, key) != 0)
-      k++;
-    if (key == NULL || *k == NULL)
-      luaL_error(L, "run: unknown option %s%s%s (options: steps, t, every)", key ? "'" : "[",
-                 luaL_tolstring(L, -2, NULL), key ? "'" : "]");
-    lua_pop(L, 1);
-  }
+  dm_checkkeys(L, 3, run_keys, "run", "option", "steps, t, every");
   int has_t = lua_getfield(L, 3, "t") != LUA_TNIL, has_n = lua_getfield(L, 3, "steps") != LUA_TNIL;
   lua_pop(L, 2);
   if (has_t == has_n)

@@ -97,6 +97,33 @@ const char *dm_tocstring(lua_State *L, int idx, const char *what)
 }
 
 /* The field's value is on top of the stack. */
+int dm_unknownkey(lua_State *L, int t, const char *const *keys)
+{
+  t = lua_absindex(L, t);
+  lua_pushnil(L);
+  while (lua_next(L, t) != 0) {
+    const char *const *k = keys;
+    const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : NULL;
+    while (key && *k && strcmp(*k, key) != 0)
+      k++;
+    lua_pop(L, 1);
+    if (key == NULL || *k == NULL)
+      return 1;
+  }
+  return 0;
+}
+
+void dm_checkkeys(lua_State *L, int t, const char *const *keys, const char *what,
+                  const char *noun, const char *list)
+{
+  if (dm_unknownkey(L, t, keys)) {
+    int str = lua_type(L, -1) == LUA_TSTRING;
+    const char *k = luaL_tolstring(L, -1, NULL);
+    luaL_error(L, "%s: unknown %s %s%s%s (%ss: %s)", what, noun, str ? "'" : "[", k,
+               str ? "'" : "]", noun, list);
+  }
+}
+
 static int fielderror(lua_State *L, int t, const char *key, const char *want)
 {
   const char *got;
