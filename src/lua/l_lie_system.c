@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "lua/l_lie_sys.h"
+#include "lua/l_system.h"
 #include "lua/l_expr.h"
 #include "expr/native.h"
 
@@ -58,62 +59,6 @@ static dm_llsys *newsys(lua_State *L, int gidx)
 /* {======================================================================
  * dm.system{space = ...}
  * ======================================================================= */
-
-static int cmp_str(const void *a, const void *b)
-{
-  return strcmp(*(const char *const *)a, *(const char *const *)b);
-}
-
-/* params = {name = value} (ordered by name) or {{name, value}, ...}:
- * pushes two userdata arrays (names anchored in the params table) */
-static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
-{
-  size_t n = 0, k;
-  int type = lua_getfield(L, t, "params"), p = lua_gettop(L), pairs;
-  const char **names;
-  double *vals;
-  if (type != LUA_TNIL && type != LUA_TTABLE)
-    luaL_error(L, "dm.system: field 'params' must be a table {name = value} or "
-               "{{name, value}, ...}, got %s", luaL_typename(L, p));
-  pairs = type == LUA_TTABLE && lua_rawlen(L, p) > 0;
-  if (type == LUA_TTABLE) {
-    lua_pushnil(L);
-    while (lua_next(L, p) != 0) {
-      n++;
-      lua_pop(L, 1);
-    }
-  }
-  names = lua_newuserdatauv(L, (n + 1) * sizeof *names, 0);
-  vals = lua_newuserdatauv(L, (n + 1) * sizeof *vals, 0);
-  for (k = 0; pairs && k < n; k++) {
-    if (lua_rawgeti(L, p, (lua_Integer)k + 1) != LUA_TTABLE ||
-        lua_rawgeti(L, -1, 1) != LUA_TSTRING || lua_rawgeti(L, -2, 2) != LUA_TNUMBER)
-      luaL_error(L, "dm.system: params entry %d must be {name, number}", (int)k + 1);
-    names[k] = lua_tostring(L, -2);
-    vals[k] = lua_tonumber(L, -1);
-    lua_pop(L, 3);
-  }
-  if (!pairs && type == LUA_TTABLE) {
-    k = 0;
-    lua_pushnil(L);
-    while (lua_next(L, p) != 0) {
-      if (lua_type(L, -2) != LUA_TSTRING || lua_type(L, -1) != LUA_TNUMBER)
-        luaL_error(L, "dm.system: params must map names to numbers (got %s = %s)",
-                   luaL_typename(L, -2), luaL_typename(L, -1));
-      names[k++] = lua_tostring(L, -2);
-      lua_pop(L, 1);
-    }
-    qsort(names, n, sizeof *names, cmp_str);
-    for (k = 0; k < n; k++) {
-      lua_getfield(L, p, names[k]);
-      vals[k] = lua_tonumber(L, -1);
-      lua_pop(L, 1);
-    }
-  }
-  *pn = names;
-  *pv = vals;
-  return n;
-}
 
 /* trace field `field` of t with the arguments at args[0..3): one
  * expression (scalar) or want of them into out */
@@ -188,7 +133,7 @@ int dm_lua_lie_system(lua_State *L)
     return luaL_error(L, "dm.system: field 'L' must be a function L(g, xi, p) returning the "
                       "Lagrangian, got %s", luaL_typename(L, -1));
   lua_pop(L, 1);
-  npar = read_params(L, 1, &pnames, &pvals);                /* 3 params, 4 names, 5 vals */
+  npar = dm_lsystem_read_params(L, 1, &pnames, &pvals);                /* 3 params, 4 names, 5 vals */
   g = lua_newuserdatauv(L, (nq + n + npar + 1) * sizeof *g, 0);  /* 6 */
   xi = g + nq;
   par = xi + n;

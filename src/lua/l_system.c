@@ -426,10 +426,7 @@ static int cmp_str(const void *a, const void *b)
   return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
-/* params = {name = value, ...} (sorted by name) or {{name, value}, ...}
- * (this order).  Pushes two userdata arrays (names, values); names are
- * anchored in the params table. */
-static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
+size_t dm_lsystem_read_params(lua_State *L, int t, const char ***pn, double **pv)
 {
   size_t n = 0, k = 0;
   int type = lua_getfield(L, t, "params"), p = lua_gettop(L), pairs;
@@ -454,8 +451,6 @@ static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
     vals[k++] = lua_tonumber(L, -1);
     lua_pop(L, 3);
   }
-  if (pairs && k != n)
-    luaL_error(L, "dm.system: params must be either {name = value} or a list of {name, value}");
   if (!pairs && type == LUA_TTABLE) {
     lua_pushnil(L);
     while (lua_next(L, p) != 0) {
@@ -472,16 +467,25 @@ static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
       lua_pop(L, 1);
     }
   }
-  for (k = 0; k < n; k++) {
+  *pn = names;
+  *pv = vals;
+  return n;
+}
+
+/* The parameters (dm_lsystem_read_params) with names that are
+ * identifiers, each once, and finite values. */
+static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
+{
+  size_t n = dm_lsystem_read_params(L, t, pn, pv);
+  const char **names = *pn;
+  for (size_t k = 0; k < n; k++) {
     if (!is_ident(names[k]))
       luaL_error(L, "dm.system: parameter name '%s' must be letters, digits and _", names[k]);
-    dm_lsystem_checkfinite(L, "dm.system", names[k], vals[k]);
+    dm_lsystem_checkfinite(L, "dm.system", names[k], (*pv)[k]);
     for (size_t j = 0; j < k; j++)
       if (strcmp(names[j], names[k]) == 0)
         luaL_error(L, "dm.system: parameter '%s' is listed twice", names[k]);
   }
-  *pn = names;
-  *pv = vals;
   return n;
 }
 
