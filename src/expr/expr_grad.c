@@ -461,6 +461,19 @@ void dm_expr_sparse_free(dm_expr_sparse *s)
   memset(s, 0, sizeof *s);
 }
 
+size_t *dm_expr__rows_start(dm_expr_ctx *ctx, swp *S, size_t n, const dm_expr *vars,
+                            size_t nrow)
+{
+  size_t *off = malloc((nrow + 1) * sizeof *off);
+  if (off == NULL || dm_expr__swp_init(ctx, S, n, vars) != 0) {
+    free(off);
+    if (off != NULL)
+      dm_expr__swp_free(S);
+    return NULL;
+  }
+  return off;
+}
+
 /* Rows r (nrow of them, row i from off[i]) as a dm_expr_sparse (takes
  * the arrays of r). */
 int dm_expr__to_sparse(rows *r, const size_t *off, size_t nrow, size_t ncol,
@@ -504,14 +517,10 @@ static int jacobian_sparse_impl(dm_expr_ctx *ctx, size_t m, const dm_expr *f,
   }
   swp S;
   rows r = { 0 };
-  size_t *off = malloc((m + 1) * sizeof *off);
+  size_t *off = dm_expr__rows_start(ctx, &S, n, vars, m);
   int s = DM_OK;
-  if (off == NULL || dm_expr__swp_init(ctx, &S, n, vars) != 0) {
-    free(off);
-    if (off != NULL)
-      dm_expr__swp_free(&S);
+  if (off == NULL)
     return dm_expr__oom_err(err, "jacobian");
-  }
   for (size_t i = 0; s == DM_OK && i < m; i++) {
     off[i] = r.n;
     if (dm_expr__sweep(ctx, &S, f[i], &r) != 0)

@@ -311,13 +311,9 @@ static int hessian_sparse_impl(dm_expr_ctx *ctx, dm_expr e, size_t n,
     return s;
   swp S;
   rows r = { 0 };
-  size_t *off = malloc((n + 1) * sizeof *off);
-  if (off == NULL || dm_expr__swp_init(ctx, &S, n, vars) != 0) {
-    free(off);
-    if (off != NULL)
-      dm_expr__swp_free(&S);
+  size_t *off = dm_expr__rows_start(ctx, &S, n, vars, n);
+  if (off == NULL)
     return dm_expr__oom_err(err, "hessian");
-  }
   for (size_t i = 0; i < n && s == DM_OK; i++)
     if (dm_expr__var_index(&S, vars[i]) != (long)i)
       s = dm_err_set(err, DM_EINVAL, "hessian: variable %zu is listed twice", i + 1);
@@ -340,13 +336,9 @@ static int hessian_impl(dm_expr_ctx *ctx, dm_expr e, size_t n, const dm_expr *va
     return s;
   swp S;
   rows r = { 0 };
-  size_t *off = malloc((n + 1) * sizeof *off);
-  if (off == NULL || dm_expr__swp_init(ctx, &S, n, vars) != 0) {
-    free(off);
-    if (off != NULL)
-      dm_expr__swp_free(&S);
+  size_t *off = dm_expr__rows_start(ctx, &S, n, vars, n);
+  if (off == NULL)
     return dm_expr__oom_err(err, "hessian");
-  }
   s = hessian_rows(ctx, &S, e, &r, off, err);
   if (s == DM_OK) {
     for (size_t k = 0; k < n * n; k++)

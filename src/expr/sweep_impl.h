@@ -73,6 +73,10 @@ int dm_expr__sweep(dm_expr_ctx *ctx, swp *S, dm_expr root, rows *out);
 int dm_expr__check_vars(dm_expr_ctx *ctx, dm_expr e, size_t n,
                         const dm_expr *vars, const char *who, dm_err *err);
 int dm_expr__oom_err(dm_err *err, const char *who);
+/* The sweep state on vars (dm_expr__swp_init) and nrow + 1 row offsets
+ * (malloc'ed), or NULL with nothing left allocated (out of memory). */
+size_t *dm_expr__rows_start(dm_expr_ctx *ctx, swp *S, size_t n, const dm_expr *vars,
+                            size_t nrow);
 int dm_expr__to_sparse(rows *r, const size_t *off, size_t nrow, size_t ncol,
                        dm_expr_sparse *out);
 int dm_expr__keep(dm_expr_ctx *ctx, int s, const dm_err *local);
