@@ -278,15 +278,23 @@ int dm_traj_write(const dm_traj *tr, FILE *f, const char *name, dm_err *e);
  * a file written in pieces). */
 int dm_traj_write_rows(const dm_traj *tr, FILE *f, const char *name, dm_err *e);
 
-/* A CSV file written in pieces as a long run goes (the run driver's sink,
- * run.h): the first put writes the header (the metadata known then) and
- * the samples, later ones the samples; close makes the file appear at
- * path, as dm_traj_save would (temporary file, rename), also after an
- * early end of the run -- what was put is kept; abandon removes it.
- * Errors as dm_traj_save's; a stream that failed keeps failing. */
+/* A CSV or HDF5 file written in pieces as a long run goes (the run
+ * driver's sink, run.h), HDF5 when the name ends in .h5, .hdf5 or .he5
+ * (dm_h5_wanted, core/trajectory_h5.h), else CSV.  CSV: the first put
+ * writes the header (the metadata known then) and the samples, later ones
+ * the samples.  HDF5: the layout of dm_traj_save_h5 with chunked,
+ * extendible datasets grown by each put, and stream_meta replaces the
+ * root attributes by a trajectory's metadata (the run's final ones: steps,
+ * status, message), so the file says how the run ended; for CSV
+ * stream_meta does nothing.  Close makes the file appear at path, as
+ * dm_traj_save would (temporary file, rename), also after an early end of
+ * the run -- what was put is kept; abandon removes it; a stream that got
+ * nothing leaves no file.  Errors as dm_traj_save's; a stream that failed
+ * keeps failing. */
 typedef struct dm_traj_stream dm_traj_stream;
 int dm_traj_stream_open(const char *path, dm_traj_stream **s, dm_err *e);
 int dm_traj_stream_put(dm_traj_stream *s, const dm_traj *tr, dm_err *e);
+int dm_traj_stream_meta(dm_traj_stream *s, const dm_traj *tr, dm_err *e);
 int dm_traj_stream_close(dm_traj_stream *s, dm_err *e);      /* NULL: DM_OK */
 void dm_traj_stream_abandon(dm_traj_stream *s);              /* NULL: no-op */
 

@@ -3,6 +3,7 @@
  * collective write of a table every MPI rank holds.  See trajectory_h5.h. */
 #include <config.h>
 #include "core/trajectory_h5.h"
+#include "core/trajectory_h5_impl.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -199,6 +200,23 @@ static int check_names(const dm_traj *tr, const char *path, dm_err *e)
   return DM_OK;
 }
 
+/* The root attributes: the format, then tr's metadata in order. */
+static int write_attrs(hid_t f, const dm_traj *tr, const char *path, dm_err *e)
+{
+  if (!put_string(f, FORMAT_KEY, FORMAT))
+    return h5_fail(e, DM_EIO, path, "cannot write the attribute " FORMAT_KEY);
+  for (size_t i = 0; i < dm_traj_meta_count(tr); i++) {
+    const char *k, *v;
+    double x;
+    int ok;
+    dm_traj_meta_at(tr, i, &k, &v);
+    ok = dm_traj_meta_number_at(tr, i, &x) ? put_number(f, k, x) : put_string(f, k, v);
+    if (!ok)
+      return h5_fail(e, DM_EIO, path, "cannot write a metadata attribute");
+  }
+  return DM_OK;
+}
+
 /* Root attributes and one dataset per column, of which this process
  * writes rows first, first + stride, ... (0, 1: all); the same selection in
  * memory (tr holds every row) and in the file.  dxpl: the transfer
@@ -229,17 +247,10 @@ static int write_columns(hid_t f, const dm_traj *tr, size_t first, size_t stride
   size_t i, j, len = dm_traj_len(tr);
   hsize_t dims[1] = {len}, start[1] = {first}, step[1] = {stride};
   hsize_t count[1] = {len > first ? (len - first + stride - 1) / stride : 0};
-  if (!put_string(f, FORMAT_KEY, FORMAT))
-    return h5_fail(e, DM_EIO, path, "cannot write the attribute " FORMAT_KEY);
-  for (i = 0; i < dm_traj_meta_count(tr); i++) {
-    const char *k, *v;
-    double x;
-    int ok;
-    dm_traj_meta_at(tr, i, &k, &v);
-    ok = dm_traj_meta_number_at(tr, i, &x) ? put_number(f, k, x) : put_string(f, k, v);
-    if (!ok)
-      return h5_fail(e, DM_EIO, path, "cannot write a metadata attribute");
-  }
+  int st = write_attrs(f, tr, path, e);
+  if (st != DM_OK)
+    return st;
+  (void)i;
   for (j = 0; j < dm_traj_ncols(tr); j++) {
     hid_t fs = H5Screate_simple(1, dims, NULL), ms = -1, d = -1;
     int ok = 0;
@@ -876,6 +887,50 @@ int dm_traj_save_h5_shared(const dm_traj *tr, const char *path, dm_err *e)
     st = dm_traj_save_h5(tr, path, e);
   return dm_mpi_agree(st, e);
 #endif
+}
+
+/* }====================================================================== */
+
+/* {==== for trajectory_h5_stream.c (trajectory_h5_impl.h) ============== */
+
+void dm_h5__lock(void)
+{
+  lock();
+}
+
+void dm_h5__unlock(void)
+{
+  unlock();
+}
+
+int dm_h5__fail(dm_err *e, int st, const char *path, const char *what)
+{
+  return h5_fail(e, st, path, what);
+}
+
+int dm_h5__put_string(hid_t obj, const char *name, const char *value)
+{
+  return put_string(obj, name, value);
+}
+
+int dm_h5__check_names(const dm_traj *tr, const char *path, dm_err *e)
+{
+  return check_names(tr, path, e);
+}
+
+int dm_h5__write_attrs(hid_t f, const dm_traj *tr, const char *path, dm_err *e)
+{
+  return write_attrs(f, tr, path, e);
+}
+
+hid_t dm_h5__ordered_fcpl(void)
+{
+  return ordered_fcpl();
+}
+
+hid_t dm_h5__unlocked_fapl(void)
+{
+  return unlocked_fapl();
 }
 
 /* }====================================================================== */

@@ -67,4 +67,18 @@ dm_traj *dm_traj_load_any(const char *path, dm_err *e);
 /* The collective save described above. */
 int dm_traj_save_h5_shared(const dm_traj *tr, const char *path, dm_err *e);
 
+/* A file written in pieces (the HDF5 side of dm_traj_stream,
+ * core/trajectory.h): the layout above, every column a chunked dataset
+ * extended by each put (the columns of every put must be those of the
+ * first); meta rewrites the root attributes from tr's metadata; close
+ * publishes the file (core/outfile.h rules, as dm_traj_save_h5: a
+ * temporary beside the target, fsync, rename; devices and FIFOs are
+ * refused), or leaves none when nothing was put; abandon removes it. */
+typedef struct dm_h5_stream dm_h5_stream;
+int dm_h5_stream_open(const char *path, dm_h5_stream **s, dm_err *e);
+int dm_h5_stream_put(dm_h5_stream *s, const dm_traj *tr, dm_err *e);
+int dm_h5_stream_meta(dm_h5_stream *s, const dm_traj *tr, dm_err *e);
+int dm_h5_stream_close(dm_h5_stream *s, dm_err *e);
+void dm_h5_stream_abandon(dm_h5_stream *s);
+
 #endif

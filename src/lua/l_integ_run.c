@@ -191,7 +191,7 @@ static void read_runopts(lua_State *L, int o, const dm_integrator *I, const dm_l
 
 /* What the sink sends samples to: a Lua function (called under pcall
  * from inside the run: its error stops the run and is reported after
- * it), or a CSV file written in pieces. */
+ * it), or a CSV or HDF5 file written in pieces. */
 typedef struct sinkctx {
   lua_State *L;
   int fn, traj;             /* stack slots of the function and the trajectory */
@@ -214,7 +214,7 @@ static int sink_call(void *ctx, const dm_traj *tr, dm_err *e)
   return DM_OK;
 }
 
-/* sink = function(traj) | "file.csv", sink_every = k into r / sc (the
+/* sink = function(traj) | "file.csv" | "file.h5", sink_every = k into r / sc (the
  * file opened). */
 static void read_sink(lua_State *L, int o, dm_run_opts *r, sinkctx *sc)
 {
@@ -235,7 +235,8 @@ static void read_sink(lua_State *L, int o, dm_run_opts *r, sinkctx *sc)
       luaL_error(L, "run: sink: %s", e.msg);
     lua_pop(L, 1);
   } else {
-    luaL_error(L, "run: option 'sink' must be a function(traj) or a file name (.csv), got %s",
+    luaL_error(L, "run: option 'sink' must be a function(traj) or a file name (.csv, .h5), "
+               "got %s",
                luaL_typename(L, -1));
   }
   r->sink = sink_call;
@@ -328,7 +329,12 @@ int dm_lua_integ_run(lua_State *L, dm_integrator *I, const dm_lsystem *ls, int o
   progress_end(&pg);
   if (sc.file != NULL) {                         /* the file appears, also after an early end */
     dm_err ce;
-    int cs = dm_traj_stream_close(sc.file, &ce);
+    /* the run's final metadata (steps, status, message) into the file */
+    int cs = dm_traj_stream_meta(sc.file, *slot, &ce);
+    if (cs != DM_OK)
+      dm_traj_stream_abandon(sc.file);
+    else
+      cs = dm_traj_stream_close(sc.file, &ce);
     if (cs != DM_OK && st == DM_OK) {
       st = cs;
       e = ce;

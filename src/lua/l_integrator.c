@@ -608,9 +608,9 @@ static const dm_reg integ_methods[] = {
    "strict = true (or dm.config.strict) makes an early end an error; traj:meta() records "
    "method, stages, h, order, steps, status and message; progress (default: stdout is a "
    "terminal) shows a line on stderr for runs over 0.5 s, chunk= fixes its steps per update.  sink = function(traj) or "
-   "\"file.csv\" streams the samples: every sink_every samples (and at the end) the function "
+   "\"file.csv\" or \"file.h5\" streams the samples: every sink_every samples (and at the end) the function "
    "gets a trajectory holding them, or they are appended to the file (which appears at the end, "
-   "also an early one), then dropped, and the run returns the last sample only; a run whose "
+   "also an early one; an HDF5 file then carries the run's steps, status and message), then dropped, and the run returns the last sample only; a run whose "
    "trajectory would take more than dm.config.memory_limit bytes (default half the physical "
    "memory) prints a warning first; for methods with variable steps (integ.variable_steps) t "
    "is the physical time, a column h holds the step lengths and t = T ends exactly at T."},
