@@ -303,23 +303,61 @@ static int s_space(lua_State *L)
   return 1;
 }
 
+/* The index of the parameter named by the string at idx, or an error
+ * from `fname` naming the system. */
+static size_t lie_param_index(lua_State *L, const dm_system *b, int idx, const char *fname)
+{
+  const char *name = lua_tostring(L, idx);
+  for (size_t i = 0; i < b->npar; i++)
+    if (strcmp(b->params[i], name) == 0)
+      return i;
+  return (size_t)luaL_error(L, "%s: no parameter '%s' in system '%s'", fname, name, b->name);
+}
+
 static int s_param(lua_State *L)
 {
   dm_llsys *ls = dm_lua_checklsys(L, 1);
   dm_lie_system *S = ls->S;
   const dm_system *b = dm_lie_system_base(S);
-  const char *name = dm_checkcstring(L, 2);
   size_t i;
-  for (i = 0; i < b->npar; i++)
-    if (strcmp(b->params[i], name) == 0)
-      break;
-  if (i == b->npar)
-    return luaL_error(L, "sys:param: no parameter '%s' in system '%s'", name, b->name);
+  dm_checkcstring(L, 2);
+  i = lie_param_index(L, b, 2, "sys:param");
   if (lua_isnoneornil(L, 3)) {
     lua_pushnumber(L, b->par[i]);
     return 1;
   }
-  dm_lie_system_par(S)[i] = luaL_checknumber(L, 3);
+  dm_lsystem_checkfinite(L, "sys:param", b->params[i], luaL_checknumber(L, 3));
+  dm_lie_system_par(S)[i] = lua_tonumber(L, 3);
+  dm_lie_system_params_changed(S);
+  lua_settop(L, 1);
+  return 1;
+}
+
+/* sys:set{name = value, ...}, as for systems in coordinates: every entry
+ * is checked before any parameter changes. */
+static int s_set(lua_State *L)
+{
+  dm_llsys *ls = dm_lua_checklsys(L, 1);
+  dm_lie_system *S = ls->S;
+  const dm_system *b = dm_lie_system_base(S);
+  luaL_checktype(L, 2, LUA_TTABLE);
+  for (int pass = 0; pass < 2; pass++) {
+    lua_pushnil(L);
+    while (lua_next(L, 2) != 0) {
+      if (pass == 0) {
+        if (lua_type(L, -2) != LUA_TSTRING)
+          return luaL_error(L, "set: parameter names are strings, got %s", luaL_typename(L, -2));
+        lie_param_index(L, b, -2, "set");
+        if (lua_type(L, -1) != LUA_TNUMBER)
+          return luaL_error(L, "set: parameter '%s' needs a number, got %s", lua_tostring(L, -2),
+                            luaL_typename(L, -1));
+        dm_lsystem_checkfinite(L, "set", lua_tostring(L, -2), lua_tonumber(L, -1));
+      } else {
+        dm_lie_system_par(S)[lie_param_index(L, b, -2, "set")] = lua_tonumber(L, -1);
+      }
+      lua_pop(L, 1);
+    }
+  }
   dm_lie_system_params_changed(S);
   lua_settop(L, 1);
   return 1;
@@ -354,6 +392,8 @@ static const dm_reg sys_methods[] = {
   {"space", s_space, "sys:space() -> G", "The Lie group the system lives on."},
   {"param", s_param, "sys:param(name[, value]) -> number | sys",
    "Read or set a parameter (integrators pick the new value up at their next step)."},
+  {"set", s_set, "sys:set{name = value, ...} -> sys",
+   "Set parameters by name, all checked (known names, finite numbers) before any changes."},
   {"is_reduced", s_is_reduced, "sys:is_reduced() -> boolean",
    "True for the Euler-Poincare (reduced) form made by dm.euler_poincare."},
   {"names", s_names, "sys:names() -> {name, ...}",

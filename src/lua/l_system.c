@@ -426,7 +426,7 @@ static int cmp_str(const void *a, const void *b)
   return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
-size_t dm_lsystem_read_params(lua_State *L, int t, const char ***pn, double **pv)
+static size_t read_params_raw(lua_State *L, int t, const char ***pn, double **pv)
 {
   size_t n = 0, k = 0;
   int type = lua_getfield(L, t, "params"), p = lua_gettop(L), pairs;
@@ -472,11 +472,12 @@ size_t dm_lsystem_read_params(lua_State *L, int t, const char ***pn, double **pv
   return n;
 }
 
-/* The parameters (dm_lsystem_read_params) with names that are
- * identifiers, each once, and finite values. */
-static size_t read_params(lua_State *L, int t, const char ***pn, double **pv)
+/* The parameters with names that are identifiers, each once, and finite
+ * values: the same rules for every kind of system (coordinates, groups,
+ * spheres). */
+size_t dm_lsystem_read_params(lua_State *L, int t, const char ***pn, double **pv)
 {
-  size_t n = dm_lsystem_read_params(L, t, pn, pv);
+  size_t n = read_params_raw(L, t, pn, pv);
   const char **names = *pn;
   for (size_t k = 0; k < n; k++) {
     if (!is_ident(names[k]))
@@ -620,7 +621,7 @@ static int l_system(lua_State *L)
   const char *name = dm_optstringfield(L, 1, "name", "system");
   dm_lsystem *ls = dm_lua_system_new(L);             /* 2 */
   coords = read_coords(L, 1, ls, &n);
-  npar = read_params(L, 1, &pnames, &pvals);
+  npar = dm_lsystem_read_params(L, 1, &pnames, &pvals);
   int mode = native_mode(L, 1);
   lua_getfield(L, 1, "L");
   if (!lua_isfunction(L, -1))

@@ -78,7 +78,8 @@ void dm_lua_system_setparam(lua_State *L, dm_lsystem *ls, size_t i, double x);
  * (this order) from field "params" of the table at t: pushes the params
  * value and two userdata arrays (names, values; names anchored in the
  * params table), returns their length.  Raises "dm.system: ..." on a
- * params value of another shape; the names are not checked further. */
+ * params value of another shape, a name that is not an identifier, a name
+ * listed twice or a value that is not finite. */
 size_t dm_lsystem_read_params(lua_State *L, int t, const char ***pn, double **pv);
 /* Raise "<what>: parameter '<name>' must be a finite number, got nan". */
 void dm_lsystem_checkfinite(lua_State *L, const char *what, const char *name, double x);

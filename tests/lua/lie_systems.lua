@@ -233,4 +233,34 @@ T.group("errors", function()
     "traj:group on another trajectory")
 end)
 
+T.group("parameters: the same rules as systems in coordinates", function()
+  local SO3 = dm.lie.SO3()
+  local function body(P)
+    return dm.system{space = SO3, params = P,
+      L = function(R, W, p) return 0.5 * (p.a * W[1]^2 + p.b * W[2]^2 + 3.4 * W[3]^2) - p.b * R[3][3] end}
+  end
+  for _, c in ipairs{{{a = 0/0, b = 1}, "parameter 'a' must be a finite number, got nan"},
+                     {{a = 1, b = -math.huge}, "parameter 'b' must be a finite number, got %-inf"},
+                     {{["a b"] = 1}, "parameter name 'a b' must be letters, digits and _"},
+                     {{{"a", 1}, {"a", 2}}, "parameter 'a' is listed twice"}} do
+    T.error_like(function() body(c[1]) end, "dm%.system: " .. c[2], "dm.system params: " .. c[2])
+    T.error_like(function()
+      dm.system{space = dm.lie.sphere(2), params = c[1], L = function(x, v, p) return v[1]^2 end}
+    end, "dm%.system: " .. c[2], "sphere params: " .. c[2])
+  end
+  local s = body{a = 2.385, b = 1.5}
+  T.error_like(function() s:set{a = 0/0} end, "set: parameter 'a' must be a finite number, got nan", "set NaN")
+  T.error_like(function() s:set{a = 3, c = 1} end, "set: no parameter 'c' in system 'system'", "set unknown")
+  T.error_like(function() s:set{b = "x"} end, "set: parameter 'b' needs a number, got string", "set string")
+  T.error_like(function() s:param("a", 1/0) end, "sys:param: parameter 'a' must be a finite number, got inf",
+    "param inf")
+  T.is(s:param("a"), 2.385, "a failed set changes nothing")
+  s:set{a = 3.125, b = 0.75}
+  local st = {g = SO3.exp{0.5, 0.1, 0}, mu = {0.5, 0.2, 1.0}}
+  local t1 = dm.integrator(s, {method = "lgvi", h = 0.01}):run(st, {steps = 200})
+  local t2 = dm.integrator(body{a = 3.125, b = 0.75}, {method = "lgvi", h = 0.01}):run(st, {steps = 200})
+  T.is(t1:column("mu1")[#t1], t2:column("mu1")[#t2], "set{} = a system made with those values (mu1)")
+  T.is(t1:column("R33")[#t1], t2:column("R33")[#t2], "set{} = a system made with those values (R33)")
+end)
+
 T.done()
