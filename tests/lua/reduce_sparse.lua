@@ -7,7 +7,8 @@
 -- to 1e-12 over 300 steps, also forced (Gauss) and constrained (Lobatto);
 -- the step Jacobians and Newton iteration counts agree (a pattern that
 -- missed an entry would change both); auto chooses by size; bad values of
--- linear and iteration are named.
+-- linear and iteration are named; the classical-Routhian path passes the
+-- options to the core engine.
 local T = require "dmech.test"
 local dm = require "dmech"
 
@@ -115,6 +116,22 @@ do
   local a = dm.integrator(red, {method = "gauss", h = 0.05, iteration = "newton"}):run(start(false), {steps = 20})
   local b = dm.integrator(red, {method = "gauss", h = 0.05, iteration = "auto"}):run(start(false), {steps = 20})
   T.is(maxdiff(a, b), 0, "iteration = newton and auto are the same Newton for RSPRK")
+end
+
+-- a Lagrangian that is not mechanical is reduced through the classical
+-- Routhian, integrated by the core engine: the options pass through
+do
+  local sys = dm.system{name = "relativistic particle", coords = {"r", "theta"}, params = {k = 0.5},
+    L = function(q, v, p) return -dm.sqrt(1 - v.r^2 - q.r^2 * v.theta^2) + p.k / q.r end}
+  local red = dm.routh(sys, {cyclic = {"theta"}, mu = 0.3})
+  local s0 = {q = {1.2385}, v = {0.1}}
+  local a = dm.integrator(red, {method = "gauss", h = 0.01, linear = "dense"})
+  local b = dm.integrator(red, {method = "gauss", h = 0.01, linear = "sparse"})
+  local d = maxdiff(a:run(s0, {steps = 100}), b:run(s0, {steps = 100}))
+  T.ok(a.stats.linear == "dense" and b.stats.linear == "sparse" and d <= 1e-12,
+       ("classical Routhian: linear reaches the core engine, same states (max diff %.2g)"):format(d))
+  T.error_like(function() dm.integrator(red, {method = "gauss", h = 0.01, linear = "banded"}) end,
+    "option 'linear' must be", "classical Routhian: a bad linear value")
 end
 
 T.done()
