@@ -552,6 +552,13 @@ static herr_t on_link(hid_t g, const char *name, const H5L_info_t *info, void *d
                        (long long)npts, r->cols[0].name, r->len);
     goto fail;
   }
+  /* a damaged type may announce numbers of gigabytes, and HDF5 fills a
+   * buffer of that size before it fails: refused before any allocation */
+  if (H5Tget_size(t) == 0 || H5Tget_size(t) > 16) {
+    r->st = dm_err_set(r->e, DM_EINVAL, "reading '%.200s': dataset '%.100s' has numbers of "
+                       "%zu bytes (a damaged file?)", r->path, name, H5Tget_size(t));
+    goto fail;
+  }
   r->len = (size_t)npts;
   if (r->ncols == r->cap) {
     size_t cap = r->cap ? 2 * r->cap : 16;
