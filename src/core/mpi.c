@@ -4,6 +4,7 @@
 #include <config.h>
 #include "core/mpi.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -210,6 +211,91 @@ int dm_mpi_allgather_bytes(const void *send, size_t count, void **recv, size_t *
   return DM_OK;
 }
 
+struct dm_mpi_counter {
+  MPI_Win win;
+  long *base;               /* the long on rank 0 */
+};
+
+int dm_mpi_counter_open(dm_mpi_counter **out, dm_err *e)
+{
+  dm_mpi_counter *c;
+  char why[DM_ERRMSG_MAX] = "";
+  int rc, ok, all_ok = 0, have_win = 0;
+  *out = NULL;
+  if (!started || size == 1)
+    return dm_err_set(e, DM_EUNSUP, "one process: nothing to share");
+  if ((c = calloc(1, sizeof *c)) == NULL)
+    snprintf(why, sizeof why, "out of memory");
+  else if ((rc = MPI_Win_allocate(rank == 0 ? (MPI_Aint)sizeof(long) : 0, (int)sizeof(long),
+                                  MPI_INFO_NULL, MPI_COMM_WORLD, &c->base, &c->win))
+           != MPI_SUCCESS) {
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    if (MPI_Error_string(rc, text, &len) != MPI_SUCCESS)
+      snprintf(text, sizeof text, "error %d", rc);
+    snprintf(why, sizeof why, "MPI_Win_allocate failed: %s", text);
+  } else {
+    have_win = 1;
+    MPI_Win_set_errhandler(c->win, MPI_ERRORS_RETURN);
+    if ((rc = MPI_Win_lock_all(MPI_MODE_NOCHECK, c->win)) != MPI_SUCCESS)
+      snprintf(why, sizeof why, "MPI_Win_lock_all failed (error %d)", rc);
+    else if (rank == 0) {
+      long zero = 0;
+      if (MPI_Accumulate(&zero, 1, MPI_LONG, 0, 0, 1, MPI_LONG, MPI_REPLACE, c->win)
+          != MPI_SUCCESS || MPI_Win_flush(0, c->win) != MPI_SUCCESS)
+        snprintf(why, sizeof why, "cannot set the counter on rank 0");
+    }
+  }
+  /* every rank learns whether all have it; the counter is 0 for everybody
+   * after this (the reduction orders rank 0's store before any take) */
+  ok = why[0] == '\0';
+  if ((rc = MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD)) != MPI_SUCCESS)
+    all_ok = 0;
+  if (!all_ok) {
+    if (have_win) {
+      if (ok)
+        MPI_Win_unlock_all(c->win);
+      MPI_Win_free(&c->win);
+    }
+    free(c);
+    if (why[0] == '\0')
+      snprintf(why, sizeof why, "another rank has no one-sided communication");
+    return dm_err_set(e, DM_EUNSUP, "MPI one-sided communication unavailable: %s", why);
+  }
+  *out = c;
+  return DM_OK;
+}
+
+int dm_mpi_counter_take(dm_mpi_counter *c, long n, long *first, dm_err *e)
+{
+  int rc;
+  if ((rc = MPI_Fetch_and_op(&n, first, MPI_LONG, 0, 0, MPI_SUM, c->win)) != MPI_SUCCESS)
+    return mpi_error(e, rc, "MPI_Fetch_and_op");
+  if ((rc = MPI_Win_flush(0, c->win)) != MPI_SUCCESS)
+    return mpi_error(e, rc, "MPI_Win_flush");
+  return DM_OK;
+}
+
+int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e)
+{
+  long end = LONG_MAX / 2, old;
+  int rc;
+  if ((rc = MPI_Fetch_and_op(&end, &old, MPI_LONG, 0, 0, MPI_REPLACE, c->win)) != MPI_SUCCESS)
+    return mpi_error(e, rc, "MPI_Fetch_and_op");
+  if ((rc = MPI_Win_flush(0, c->win)) != MPI_SUCCESS)
+    return mpi_error(e, rc, "MPI_Win_flush");
+  return DM_OK;
+}
+
+void dm_mpi_counter_free(dm_mpi_counter *c)
+{
+  if (c == NULL)
+    return;
+  MPI_Win_unlock_all(c->win);
+  MPI_Win_free(&c->win);
+  free(c);
+}
+
 void dm_mpi_fail(int code)
 {
   if (started)
@@ -251,6 +337,25 @@ int dm_mpi_allgather_bytes(const void *send, size_t count, void **recv, size_t *
   return DM_OK;
 }
 
+struct dm_mpi_counter {
+  long unused;
+};
+
+int dm_mpi_counter_open(dm_mpi_counter **c, dm_err *e)
+{
+  *c = NULL;
+  return dm_err_set(e, DM_EUNSUP, "built without MPI");
+}
+
+int dm_mpi_counter_take(dm_mpi_counter *c, long n, long *first, dm_err *e)
+{
+  (void)c, (void)n, (void)e;
+  *first = LONG_MAX / 2;
+  return DM_OK;
+}
+
+int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e) { (void)c; (void)e; return DM_OK; }
+void dm_mpi_counter_free(dm_mpi_counter *c) { (void)c; }
 void dm_mpi_fail(int code) { (void)code; }
 
 #endif

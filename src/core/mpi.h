@@ -58,6 +58,27 @@ int dm_mpi_sum_long(long *x, dm_err *e);
 int dm_mpi_allgather_bytes(const void *send, size_t count, void **recv, size_t *recv_len,
                            size_t *counts, dm_err *e);
 
+/* A counter shared by all ranks for dealing work dynamically: an MPI-3
+ * window of one long on rank 0 (MPI_Win_allocate), read and advanced with
+ * MPI_Fetch_and_op in a passive-target epoch (MPI_Win_lock_all), so a rank
+ * takes the next items without the others taking part.  On one node Open
+ * MPI serves it from shared memory (osc/sm).
+ *
+ * dm_mpi_counter_open is collective: every rank gets the counter at 0, or
+ * every rank gets DM_EUNSUP with the reason (no one-sided component, a
+ * build without MPI, a single process) and *c = NULL -- the caller then
+ * deals the work statically.  dm_mpi_counter_take adds n and returns the
+ * value before (*first; the items [first, first + n) are the caller's).
+ * dm_mpi_counter_close makes every later take return a value beyond any
+ * count (LONG_MAX / 2 or more): the others take no more.
+ * dm_mpi_counter_free is collective (every rank that opened it); NULL is a
+ * no-op.  Calls from the thread that called dm_mpi_start only. */
+typedef struct dm_mpi_counter dm_mpi_counter;
+int dm_mpi_counter_open(dm_mpi_counter **c, dm_err *e);
+int dm_mpi_counter_take(dm_mpi_counter *c, long n, long *first, dm_err *e);
+int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e);
+void dm_mpi_counter_free(dm_mpi_counter *c);
+
 /* End every rank of the job now (MPI_Abort) when MPI is active; no-op
  * otherwise.  For a process that is about to exit after an error, so that
  * no other rank is left waiting in a collective. */
