@@ -132,7 +132,7 @@ static void run_batch(ens *E, double t_start, long done_before)
       dm_ens_progress pr;
       last = tn;
       pr.done = done_before + atomic_load(&E->done);
-      pr.total = E->count;
+      pr.total = E->idx != NULL ? E->o->members : E->count;
       pr.failed = atomic_load(&E->failed);
       pr.elapsed = tn - t_start;
       pthread_mutex_unlock(&E->mu);
@@ -284,6 +284,7 @@ static void ens_free(ens *E)
       free(E->msg[j]);
   free(E->msg);
   free(E->rows);
+  free(E->idx);
   free(E->q0);
   if (E->traj != NULL)
     for (j = 0; j < E->nb; j++)
@@ -395,6 +396,79 @@ static int run_local(ens *E, dm_err *e)
   return st;
 }
 
+/* Room for n more slots (dynamic dealing; between batches only). */
+static int grow(ens *E, long n, dm_err *e)
+{
+  long cap = E->cap;
+  double *rows;
+  char **msg;
+  long *idx;
+  if (E->count + n <= cap)
+    return DM_OK;
+  while (cap < E->count + n)
+    cap = cap < 64 ? 64 : 2 * cap;
+  if (cap > E->o->members)
+    cap = E->o->members;
+  if ((rows = realloc(E->rows, ((size_t)cap + 1) * E->nvals * sizeof *rows)) != NULL)
+    E->rows = rows;
+  if ((msg = realloc(E->msg, ((size_t)cap + 1) * sizeof *msg)) != NULL) {
+    memset(msg + E->cap, 0, (size_t)(cap + 1 - E->cap) * sizeof *msg);
+    E->msg = msg;
+  }
+  if ((idx = realloc(E->idx, ((size_t)cap + 1) * sizeof *idx)) != NULL)
+    E->idx = idx;
+  if (rows == NULL || msg == NULL || idx == NULL)
+    return dm_err_set(e, DM_ENOMEM, "out of memory for %ld members", cap);
+  E->cap = cap;
+  return DM_OK;
+}
+
+/* This rank's members, taken batch by batch from the counter shared by the
+ * ranks (doc/ensembles.md §6): a batch is about 1/(2P) of the members not
+ * yet taken, at least one per thread and at most the batch size, so the
+ * batches shrink toward the end and the ranks finish together however
+ * unequal the members' costs.  A rank that stops (Ctrl-C, the progress
+ * callback, an error) closes the counter: the others finish the batch in
+ * hand and take no more. */
+static int run_dynamic(ens *E, dm_mpi_counter *C, int size, dm_err *e)
+{
+  long M = E->o->members, B = E->o->batch, seen = 0;
+  double t0 = now();
+  int st = DM_OK;
+  if (B == 0)
+    B = E->user ? 16L * E->nworkers : 4096L;
+  for (;;) {
+    long want = (M - seen + 2L * size - 1) / (2L * size), k0, i;
+    if (atomic_load(&E->stop) || dm_interrupted())
+      break;
+    if (want < E->nworkers)
+      want = E->nworkers;
+    if (want > B)
+      want = B;
+    if ((st = dm_mpi_counter_take(C, want, &k0, e)) != DM_OK || k0 >= M)
+      break;
+    E->nb = M - k0 < want ? M - k0 : want;
+    seen = k0 + E->nb > seen ? k0 + E->nb : seen;
+    if ((st = grow(E, E->nb, e)) != DM_OK)
+      break;
+    E->b0 = E->count;
+    for (i = 0; i < E->nb; i++)
+      E->idx[E->b0 + i] = k0 + i;
+    E->count += E->nb;
+    if ((st = batch_starts(E, e)) != DM_OK)
+      break;
+    if (!atomic_load(&E->stop) && !dm_interrupted())
+      run_batch(E, t0, E->b0);
+    if (E->user && (st = batch_user(E, e)) != DM_OK)
+      break;
+  }
+  if (st != DM_OK || atomic_load(&E->stop) || dm_interrupted()) {
+    dm_err le;
+    dm_mpi_counter_close(C, &le);
+  }
+  return st;
+}
+
 /* Pack this rank's messages as records "j\0text\0". */
 static char *pack_messages(const ens *E, size_t *len)
 {
@@ -432,9 +506,9 @@ static int gather(ens *E, dm_traj *tr, long *nfailed, long *nintr, dm_err *e)
   size_t *counts = calloc(size, sizeof *counts), len = 0, mlen = 0, pos;
   char *mine = NULL, *msgs = NULL;
   void *all = NULL;
-  long M = E->o->members, k, nmsg = 0, failed = 0, intr = 0, *keys = NULL;
+  long M = E->o->members, k, nmsg = 0, failed = 0, intr = 0, *keys = NULL, *idx = NULL;
   const double *rows;
-  double **rowp = NULL;
+  double **rowp = NULL, *notrun = NULL;
   int st;
   if (counts == NULL || (mine = pack_messages(E, &mlen)) == NULL) {
     free(counts);
@@ -447,24 +521,42 @@ static int gather(ens *E, dm_traj *tr, long *nfailed, long *nintr, dm_err *e)
       st = dm_mpi_allgather_bytes(mine, mlen, &m, &mlen, NULL, e);
       msgs = m;
     }
+    if (st == DM_OK && E->idx != NULL) {
+      void *x = NULL;
+      size_t xlen;
+      st = dm_mpi_allgather_bytes(E->idx, (size_t)E->count * sizeof *E->idx, &x, &xlen, NULL, e);
+      idx = x;
+    }
   } else {
     all = E->rows;
     counts[0] = (size_t)E->count * rowb;
     msgs = mine;
     st = DM_OK;
   }
-  if (st == DM_OK && (rowp = malloc((size_t)M * sizeof *rowp)) == NULL)
+  if (st == DM_OK && (rowp = calloc((size_t)M, sizeof *rowp)) == NULL)
+    st = dm_err_set(e, DM_ENOMEM, "out of memory");
+  if (st == DM_OK && (notrun = malloc(rowb)) == NULL)
     st = dm_err_set(e, DM_ENOMEM, "out of memory");
   if (st != DM_OK)
     goto out;
-  /* rank r's j-th row is member r + j size */
+  /* rank r's j-th row is member r + j size (cyclic), or the member its
+   * j-th index says (dynamic: the indices gathered in the same order);
+   * members nobody took (a stop) were not run */
   rows = all;
-  for (r = 0, pos = 0; r < size; r++) {
+  for (r = 0, pos = 0, k = 0; r < size; r++) {
     long cnt = (long)(counts[r] / rowb), j;
-    for (j = 0; j < cnt; j++)
-      rowp[(long)r + j * (long)size] = (double *)(rows + (pos / sizeof(double)) + (size_t)j * E->nvals);
+    for (j = 0; j < cnt; j++, k++) {
+      long m = idx != NULL ? idx[k] : E->idx != NULL ? E->idx[j] : (long)r + j * (long)size;
+      rowp[m] = (double *)(rows + (pos / sizeof(double)) + (size_t)j * E->nvals);
+    }
     pos += counts[r];
   }
+  for (r = 0; r < E->nvals; r++)
+    notrun[r] = NAN;
+  notrun[E->col_status] = DM_EINTR;
+  for (k = 0; k < M; k++)
+    if (rowp[k] == NULL)
+      rowp[k] = notrun;
   if ((st = dm_traj_reserve(tr, (size_t)M, e)) != DM_OK)
     goto out;
   for (k = 0; k < M && st == DM_OK; k++) {
@@ -512,6 +604,8 @@ out:
   free(mine);
   free(keys);
   free(rowp);
+  free(notrun);
+  free(idx);
   free(counts);
   return st;
 }
@@ -524,7 +618,10 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
   dm_err le;
   double t0 = now();
   int st, t, size = 1, rank = 0;
-  long failed = 0, intr = 0;
+  long failed = 0, intr = 0, mine;
+  dm_mpi_counter *C = NULL;
+  char note[DM_ERRMSG_MAX + 96] = "";
+  dm_err ce;
   *out = NULL;
   if (sum != NULL)
     memset(sum, 0, sizeof *sum);
@@ -562,26 +659,37 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
     size = dm_mpi_size();
     rank = dm_mpi_rank();
   }
+  /* several ranks take batches from a shared counter; without one-sided
+   * communication they deal the members cyclically (every rank the same) */
+  if (size > 1 && dm_mpi_counter_open(&C, &ce) != DM_OK)
+    snprintf(note, sizeof note, "members dealt cyclically over the ranks, not balanced "
+             "(%s)", ce.msg);
   E.first = rank;
   E.stride = size;
-  E.count = o->members > rank ? (o->members - rank + size - 1) / size : 0;
+  E.count = C != NULL ? 0 : o->members > rank ? (o->members - rank + size - 1) / size : 0;
+  mine = C != NULL ? o->members : E.count;
   E.nworkers = o->threads > 0 ? o->threads : default_threads();
-  if (E.nworkers > E.count)
-    E.nworkers = E.count > 0 ? (int)E.count : 1;
+  if (E.nworkers > mine)
+    E.nworkers = mine > 0 ? (int)mine : 1;
   /* from here on every rank reaches the agreement below */
   if ((tr = new_table(&E, e)) == NULL)
     st = e->status;
   if (st == DM_OK) {
     long B = o->batch > 0 ? o->batch : E.user ? 16L * E.nworkers : 4096L;
-    size_t nb = (size_t)(B < E.count ? B : E.count > 0 ? E.count : 1);
-    E.rows = malloc(((size_t)E.count + 1) * E.nvals * sizeof *E.rows);
-    E.msg = calloc((size_t)E.count + 1, sizeof *E.msg);
+    size_t nb = (size_t)(B < mine ? B : mine > 0 ? mine : 1);
+    if (C == NULL) {
+      E.rows = malloc(((size_t)E.count + 1) * E.nvals * sizeof *E.rows);
+      E.msg = calloc((size_t)E.count + 1, sizeof *E.msg);
+      E.cap = E.count;
+    } else {
+      st = grow(&E, 1, e);       /* the slots grow as batches are taken */
+    }
     E.q0 = malloc((nb * (E.nq + E.n + E.npar) + 1) * sizeof *E.q0);
     E.traj = E.user ? calloc(nb, sizeof *E.traj) : NULL;
     E.w = calloc((size_t)E.nworkers, sizeof *E.w);
-    if (E.rows == NULL || E.msg == NULL || E.q0 == NULL || (E.user && E.traj == NULL)
-        || E.w == NULL) {
-      st = dm_err_set(e, DM_ENOMEM, "out of memory for %ld members", E.count);
+    if (st != DM_OK || E.rows == NULL || E.msg == NULL || E.q0 == NULL
+        || (E.user && E.traj == NULL) || E.w == NULL) {
+      st = dm_err_set(e, DM_ENOMEM, "out of memory for %ld members", mine);
     } else {
       E.p0 = E.q0 + nb * E.nq;
       E.par0 = E.p0 + nb * E.n;
@@ -590,7 +698,11 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
   for (t = 0; st == DM_OK && t < E.nworkers; t++)
     st = dm_ens__worker_init(&E, &E.w[t], e);
   if (st == DM_OK)
-    st = run_local(&E, e);
+    st = C != NULL ? run_dynamic(&E, C, size, e) : run_local(&E, e);
+  else if (C != NULL)
+    dm_mpi_counter_close(C, &ce);      /* this rank cannot run: the others stop too */
+  dm_mpi_counter_free(C);              /* collective */
+  C = NULL;
   if (o->distributed)
     st = dm_mpi_agree(st, e);
   if (st == DM_OK)
@@ -617,6 +729,7 @@ int dm_ensemble_run(const dm_integrator *I, const dm_ens_opts *o, dm_traj **out,
     sum->failed = failed;
     sum->status = st;
     sum->elapsed = now() - t0;
+    snprintf(sum->note, sizeof sum->note, "%s", note);
   }
   return st;
 fail:

@@ -69,8 +69,12 @@
  * returns no table.
  *
  * MPI.  With `distributed` set and the process one of several MPI ranks
- * (mpi.h), rank r runs the members k = r, r + size, ... and the rows are
- * gathered to every rank, so each rank returns the whole table; every rank
+ * (mpi.h), the ranks take batches of members from a counter they share
+ * (dm_mpi_counter_take; batches of about 1/(2 size) of the members left,
+ * shrinking toward the end) -- or, without MPI one-sided communication,
+ * rank r runs the members k = r, r + size, ... and the summary's note says
+ * so -- and the rows are gathered to every rank in member order, so each
+ * rank returns the whole table, whoever ran which member; every rank
  * must make the same call (start and user callbacks are called on the rank
  * that runs the member).  A failure of one rank (callback error, memory) is
  * agreed on by all, which return it ("rank 1: ..."), so none is left
@@ -172,6 +176,8 @@ typedef struct dm_ens_summary {
   long members, done, failed;   /* over all ranks */
   int status;                   /* the return value */
   double elapsed;               /* seconds, this rank */
+  char note[DM_ERRMSG_MAX];     /* "", or why several ranks dealt the members
+                                   cyclically instead of from a shared counter */
 } dm_ens_summary;
 
 void dm_ens_opts_init(dm_ens_opts *o);

@@ -34,10 +34,12 @@ struct ens {
                                user, status */
   size_t col_status;
   int variational, samples, user;
-  /* this rank's members: k = first + j * stride, j < count */
-  long first, stride, count;
-  double *rows;             /* count x nvals */
-  char **msg;               /* count */
+  /* this rank's members: k = first + j * stride, j < count (dealt
+   * cyclically), or k = idx[j] (taken in batches from the shared counter,
+   * doc/ensembles.md §6); cap slots allocated */
+  long first, stride, count, cap, *idx;
+  double *rows;             /* cap x nvals */
+  char **msg;               /* cap */
   /* the batch */
   long b0, nb;
   double *q0, *p0, *par0;   /* nb x nq, nb x n, nb x npar */
@@ -50,7 +52,10 @@ struct ens {
   worker *w;
 };
 
-static inline long member_of(const ens *E, long j) { return E->first + j * E->stride; }
+static inline long member_of(const ens *E, long j)
+{
+  return E->idx != NULL ? E->idx[j] : E->first + j * E->stride;
+}
 
 /* A worker's buffers, system copy (params mode) and integrator; free. */
 int dm_ens__worker_init(ens *E, worker *w, dm_err *e);

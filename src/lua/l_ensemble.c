@@ -593,6 +593,11 @@ static int l_ensemble(lua_State *L)
     return dm_lua_fail(L, "dm.ensemble", st, &e);
   if (dm_mpi_size() > 1)
     dm_traj_mark_replica(L, -1);
+  if (sum.note[0] != '\0' && dm_mpi_rank() == 0) {
+    lua_pushfstring(L, "dm.ensemble: %s", sum.note);
+    dm_lua_warning(L, lua_tostring(L, -1));
+    lua_pop(L, 1);
+  }
   if (st == DM_OK && sum.failed == 0)
     return 1;
   if (st == DM_OK || st == DM_EINTR) {
