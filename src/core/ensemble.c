@@ -103,7 +103,7 @@ static void *work(void *arg)
 static void run_batch(ens *E, double t_start, long done_before)
 {
   int t, started = 0;
-  double last = now();
+  double last = now(), polled = last;
   atomic_store(&E->next, 0);
   atomic_store(&E->done, 0);
   for (t = 0; t < E->nworkers; t++) {
@@ -128,6 +128,12 @@ static void run_batch(ens *E, double t_start, long done_before)
     if (dm_interrupted())
       atomic_store(&E->stop, 1);
     tn = now();
+    /* another rank stopped (Ctrl-C there, an error): start no more */
+    if (E->counter != NULL && tn - polled >= 0.25) {
+      polled = tn;
+      if (dm_mpi_counter_closed(E->counter))
+        atomic_store(&E->stop, 1);
+    }
     if (E->o->progress != NULL && tn - last >= 0.25 && !atomic_load(&E->stop)) {
       dm_ens_progress pr;
       last = tn;
@@ -428,8 +434,9 @@ static int grow(ens *E, long n, dm_err *e)
  * yet taken, at least one per thread and at most the batch size, so the
  * batches shrink toward the end and the ranks finish together however
  * unequal the members' costs.  A rank that stops (Ctrl-C, the progress
- * callback, an error) closes the counter: the others finish the batch in
- * hand and take no more. */
+ * callback, an error) closes the counter: the others see it within a
+ * quarter of a second (run_batch), finish the members in flight, start no
+ * more and take no more batches. */
 static int run_dynamic(ens *E, dm_mpi_counter *C, int size, dm_err *e)
 {
   long M = E->o->members, B = E->o->batch, seen = 0;
@@ -437,6 +444,7 @@ static int run_dynamic(ens *E, dm_mpi_counter *C, int size, dm_err *e)
   int st = DM_OK;
   if (B == 0)
     B = E->user ? 16L * E->nworkers : 4096L;
+  E->counter = C;
   for (;;) {
     long want = (M - seen + 2L * size - 1) / (2L * size), k0, i;
     if (atomic_load(&E->stop) || dm_interrupted())
@@ -466,6 +474,7 @@ static int run_dynamic(ens *E, dm_mpi_counter *C, int size, dm_err *e)
     dm_err le;
     dm_mpi_counter_close(C, &le);
   }
+  E->counter = NULL;
   return st;
 }
 

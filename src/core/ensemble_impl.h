@@ -38,6 +38,7 @@ struct ens {
    * cyclically), or k = idx[j] (taken in batches from the shared counter,
    * doc/ensembles.md §6); cap slots allocated */
   long first, stride, count, cap, *idx;
+  struct dm_mpi_counter *counter;   /* the shared counter (dynamic dealing) */
   double *rows;             /* cap x nvals */
   char **msg;               /* cap */
   /* the batch */

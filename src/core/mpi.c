@@ -287,6 +287,15 @@ int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e)
   return DM_OK;
 }
 
+int dm_mpi_counter_closed(dm_mpi_counter *c)
+{
+  long v = 0;
+  if (MPI_Fetch_and_op(NULL, &v, MPI_LONG, 0, 0, MPI_NO_OP, c->win) != MPI_SUCCESS
+      || MPI_Win_flush(0, c->win) != MPI_SUCCESS)
+    return 0;
+  return v >= LONG_MAX / 2;
+}
+
 void dm_mpi_counter_free(dm_mpi_counter *c)
 {
   if (c == NULL)
@@ -355,6 +364,7 @@ int dm_mpi_counter_take(dm_mpi_counter *c, long n, long *first, dm_err *e)
 }
 
 int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e) { (void)c; (void)e; return DM_OK; }
+int dm_mpi_counter_closed(dm_mpi_counter *c) { (void)c; return 0; }
 void dm_mpi_counter_free(dm_mpi_counter *c) { (void)c; }
 void dm_mpi_fail(int code) { (void)code; }
 

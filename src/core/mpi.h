@@ -70,13 +70,16 @@ int dm_mpi_allgather_bytes(const void *send, size_t count, void **recv, size_t *
  * deals the work statically.  dm_mpi_counter_take adds n and returns the
  * value before (*first; the items [first, first + n) are the caller's).
  * dm_mpi_counter_close makes every later take return a value beyond any
- * count (LONG_MAX / 2 or more): the others take no more.
+ * count (LONG_MAX / 2 or more): the others take no more;
+ * dm_mpi_counter_closed reads the counter and says whether some rank
+ * closed it (0 also when the read fails).
  * dm_mpi_counter_free is collective (every rank that opened it); NULL is a
  * no-op.  Calls from the thread that called dm_mpi_start only. */
 typedef struct dm_mpi_counter dm_mpi_counter;
 int dm_mpi_counter_open(dm_mpi_counter **c, dm_err *e);
 int dm_mpi_counter_take(dm_mpi_counter *c, long n, long *first, dm_err *e);
 int dm_mpi_counter_close(dm_mpi_counter *c, dm_err *e);
+int dm_mpi_counter_closed(dm_mpi_counter *c);
 void dm_mpi_counter_free(dm_mpi_counter *c);
 
 /* End every rank of the job now (MPI_Abort) when MPI is active; no-op

@@ -82,5 +82,41 @@ like "$out" "warning: dm.ensemble: members dealt cyclically over the ranks, not 
 like "$out" "48 (01){24}" "and they are: member k on rank (k - 1) mod 2"
 is "$("$DMECH" "$tmp/same.lua" "$tmp/one/unequal.h5" "$tmp/cyclic/unequal.h5" 2>&1)" \
   "same, unequal" "the same table, bit for bit"
+
+# Ctrl-C on one rank (SIGINT to that process): it stops its members, closes
+# the counter, the other rank sees it within a quarter of a second and
+# starts no more (without that it would finish its first batch of 100);
+# both return the whole table with the finished members kept and the rest
+# "not run".
+cat > "$tmp/long.lua" <<'LUA'
+dm.config.interrupt = "run"
+local I = dm.integrator(dm.systems.kepler{impl = "c"}, {method = "gauss", h = 0.01})
+local res, msg = dm.ensemble{integrator = I, members = 400, threads = 1, progress = true,
+  run = {steps = 300000}, reduce = {"final"},
+  states = function(k) return {q = {0.5 + 0.001 * k, 0}, p = {0, 1.3}} end}
+local done, notrun = 0, 0
+for k = 1, #res do
+  if res[k].status == 0 then done = done + 1 elseif res[k].t ~= res[k].t then notrun = notrun + 1 end
+end
+print(("rank %d: %d rows, %s, not run %s"):format(dm.mpi.rank(), #res, msg,
+  notrun >= 350 and ">= 350" or notrun))
+LUA
+timeout 120 "$MPIRUN" --allow-run-as-root --oversubscribe --mca btl self,vader -np 2 \
+  "$DMECH" "$tmp/long.lua" > "$tmp/out" 2> "$tmp/err" &
+mpid=$!
+i=0
+while [ $i -lt 600 ] && ! grep -q "ensemble: [1-9][0-9]*/400 members" "$tmp/err" 2>/dev/null; do
+  sleep 0.05; i=$((i + 1)); done
+# timeout's child is mpirun, whose children are the ranks
+rank=$(pgrep -P "$(pgrep -P $mpid | head -n 1)" | tail -n 1)
+kill -INT $rank 2>/dev/null
+wait $mpid; st=$?
+out=$(sort "$tmp/out")
+is "$st" 0 "SIGINT to one rank: the job goes on to the end of the script"
+n0=$(printf '%s\n' "$out" | sed -n 's/^rank 0: 400 rows, dm.ensemble: interrupted: \([0-9]*\) of 400 members finished; they are kept, not run >= 350$/\1/p')
+n1=$(printf '%s\n' "$out" | sed -n 's/^rank 1: 400 rows, dm.ensemble: interrupted: \([0-9]*\) of 400 members finished; they are kept, not run >= 350$/\1/p')
+ok "$([ -n "$n0" ] && [ "$n0" = "$n1" ] && echo 0 || echo 1)" \
+  "both ranks return the whole table ($n0 and $n1 finished): the rest stopped soon, not run"
+[ -n "$n0" ] && [ "$n0" = "$n1" ] || printf '%s\n' "$out" | sed 's/^/#   /'
 rm -rf "$tmp"
 done_testing
